@@ -1,0 +1,198 @@
+//! The transform kernels, each written once over a lane type.
+//!
+//! Every kernel maps a box `[lo, hi]` through `x ↦ M x + t`, where `M` is given by its
+//! columns. The kernels are pure round-to-nearest arithmetic: they assume a finite,
+//! non-empty box and a finite matrix, and their callers check that the result is finite.
+//! Everything outside that domain (empty, unbounded or NaN boxes, overflow, non-finite
+//! matrices) is answered by [`crate::extended`].
+
+use crate::lane::{Axes, Lane, Vector};
+use crate::method::{Method, TINY_PAD, UNIT_ROUNDOFF};
+
+/// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AffineLanes<V, const N: usize> {
+    pub cols: [V; N],
+    pub t: V,
+}
+
+/// The naive baseline: transform all `2^N` corners and take their min and max.
+///
+/// A corner whose sum overflowed to `±inf` (or to NaN, as `inf − inf`) could be hidden by
+/// the min/max reduction, which may drop NaN operands. The running sum of all corners is
+/// non-finite whenever any corner is, so it poisons the result to NaN and the caller's
+/// finiteness check routes the box to the extended path.
+#[inline(always)]
+pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V) -> (V, V) {
+    let mut min = V::splat(f32::INFINITY);
+    let mut max = V::splat(f32::NEG_INFINITY);
+    let mut corner_sum = V::splat(0.0);
+    for corner in 0..1usize << N {
+        let mut p = a.t;
+        for j in 0..N {
+            let x = if corner >> j & 1 == 0 { lo } else { hi };
+            p = a.cols[j].mul_add(x.axis(j), p);
+        }
+        min = min.min(p);
+        max = max.max(p);
+        corner_sum = corner_sum + p;
+    }
+    let poison = corner_sum * V::splat(0.0); // 0 when every corner is finite, else NaN
+    (min + poison, max + poison)
+}
+
+/// Arvo's abs-matrix method in doubled form: `2c = lo + hi`, `2e = hi − lo`,
+/// `2c' = M·2c + 2t`, `2e' = |M|·2e`, faces `(2c' ∓ 2e') / 2`.
+///
+/// Halving last keeps subnormal boxes exact up to the final rounding (halving first
+/// would flush the half-width of a one-ulp subnormal box to zero). Doubling can overflow
+/// for faces beyond `f32::MAX / 2`; the result is then non-finite and the caller routes the
+/// box to the extended path.
+///
+/// Error: `2c` and `2e` round once each, the dot products of `N` terms (onto `2t`) at most
+/// `N + 1` times, the final difference once; halving is exact above the subnormal range
+/// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo_j|, |hi_j|)` the face
+/// error is at most `γ(N+3)·S + TINY_ERROR`.
+#[inline(always)]
+pub(crate) fn abs_matrix<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V) -> (V, V) {
+    let center2 = lo + hi;
+    let extent2 = hi - lo;
+    let mut world_center2 = a.t + a.t;
+    let mut world_extent2 = V::splat(0.0);
+    for j in 0..N {
+        world_center2 = a.cols[j].mul_add(center2.axis(j), world_center2);
+        world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
+    }
+    let half = V::splat(0.5);
+    (
+        (world_center2 - world_extent2) * half,
+        (world_center2 + world_extent2) * half,
+    )
+}
+
+/// Sign-select: face `i` of the minimum is `t_i + sum_j m_ij * (m_ij >= 0 ? lo_j : hi_j)`,
+/// and the maximum takes the other face. No center/extent round trip.
+///
+/// Error: `N` products and `N` additions per face, `γ(N+1)·S + TINY_ERROR`.
+#[inline(always)]
+pub(crate) fn sign_select<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V) -> (V, V) {
+    let mut min = a.t;
+    let mut max = a.t;
+    for j in 0..N {
+        let m = a.cols[j];
+        let (lo_j, hi_j) = (lo.axis(j), hi.axis(j));
+        min = m.mul_add(m.select_nonneg(lo_j, hi_j), min);
+        max = m.mul_add(m.select_nonneg(hi_j, lo_j), max);
+    }
+    (min, max)
+}
+
+/// Eberly's sign branch for a 2D rotation `[[c, −s], [s, c]]` plus translation.
+///
+/// The signs of `cos` and `sin` (two comparisons) pick one of four cases, each fixing which
+/// face of the box minimises every term; the faces are then 8 multiplications and 8
+/// additions. With `L = f32` each `select_nonneg` is that branch; in wider lanes it is a
+/// blend. Same error as [`sign_select`] in 2D: `γ(3)·S + TINY_ERROR`.
+#[inline(always)]
+pub(crate) fn sign_branch_rigid2<L: Lane>(
+    cos: L,
+    sin: L,
+    t: [L; 2],
+    lo: [L; 2],
+    hi: [L; 2],
+) -> ([L; 2], [L; 2]) {
+    let [lx, ly] = lo;
+    let [hx, hy] = hi;
+    // Faces that minimise c·x, c·y, s·x and −s·y.
+    let (cx_min, cx_max) = (cos.select_nonneg(lx, hx), cos.select_nonneg(hx, lx));
+    let (cy_min, cy_max) = (cos.select_nonneg(ly, hy), cos.select_nonneg(hy, ly));
+    let (sx_min, sx_max) = (sin.select_nonneg(lx, hx), sin.select_nonneg(hx, lx));
+    let (sy_min, sy_max) = (sin.select_nonneg(hy, ly), sin.select_nonneg(ly, hy));
+    let neg_sin = -sin;
+    (
+        [
+            cos.mul_add(cx_min, neg_sin.mul_add(sy_min, t[0])),
+            sin.mul_add(sx_min, cos.mul_add(cy_min, t[1])),
+        ],
+        [
+            cos.mul_add(cx_max, neg_sin.mul_add(sy_max, t[0])),
+            sin.mul_add(sx_max, cos.mul_add(cy_max, t[1])),
+        ],
+    )
+}
+
+/// The Outward pad `k·u·S + TINY_PAD`, with `S_i = |t_i| + sum_j |m_ij|·max(|lo_j|, |hi_j|)`
+/// computed in the same lanes (`max(hi, −lo)` equals `max(|lo|, |hi|)` when `lo <= hi`).
+///
+/// Why `k = n + 2` suffices for a Nearest bound `γ(n)·S`: the computed `S` (positive
+/// terms only) is at least `S·(1 − γ(N+1))`, the pad's own product rounds once, and the
+/// padded face `fl(face ∓ pad)` rounds once more by at most `u·(|face| + pad)`. Hence
+/// `pad − error − rounding >= (k − n − 1)·u·S − O(u²·S) > 0`; the absolute terms are
+/// covered by `TINY_PAD >= 2·TINY_ERROR + 2^-150`.
+#[inline(always)]
+pub(crate) fn outward_pad<V: Axes, const N: usize>(
+    a: &AffineLanes<V, N>,
+    lo: V,
+    hi: V,
+    k: u32,
+) -> V {
+    let magnitude = hi.max(-lo);
+    let mut s = a.t.abs();
+    for j in 0..N {
+        s = a.cols[j].abs().mul_add(magnitude.axis(j), s);
+    }
+    s.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(TINY_PAD))
+}
+
+/// One box through one method, padded outward when asked: the fast path of every entry
+/// point. The caller checks the input box is non-empty and the result finite.
+#[inline(always)]
+pub(crate) fn transform<V: Axes, const N: usize>(
+    a: &AffineLanes<V, N>,
+    lo: V,
+    hi: V,
+    method: Method,
+    outward: bool,
+) -> (V, V) {
+    let (min, max) = match method {
+        Method::Naive => naive(a, lo, hi),
+        Method::AbsMatrix => abs_matrix(a, lo, hi),
+        Method::SignSelect => sign_select(a, lo, hi),
+    };
+    if outward {
+        let pad = outward_pad(a, lo, hi, method.outward_pad(N as u32));
+        (min - pad, max + pad)
+    } else {
+        (min, max)
+    }
+}
+
+/// One box through a rigid 2D transform `[[cos, −sin], [sin, cos]]`, `t`:
+/// [`Method::SignSelect`] is Eberly's [`sign_branch_rigid2`], the others run as for any
+/// affine map. Same contract as [`transform`].
+#[inline(always)]
+pub(crate) fn transform_rigid2<L: Lane>(
+    cos: L,
+    sin: L,
+    t: [L; 2],
+    lo: [L; 2],
+    hi: [L; 2],
+    method: Method,
+    outward: bool,
+) -> ([L; 2], [L; 2]) {
+    let a = AffineLanes {
+        cols: [Vector([cos, sin]), Vector([-sin, cos])],
+        t: Vector(t),
+    };
+    if method != Method::SignSelect {
+        let (min, max) = transform(&a, Vector(lo), Vector(hi), method, outward);
+        return (min.0, max.0);
+    }
+    let (min, max) = sign_branch_rigid2(cos, sin, t, lo, hi);
+    if outward {
+        let pad = outward_pad(&a, Vector(lo), Vector(hi), method.outward_pad(2));
+        ((Vector(min) - pad).0, (Vector(max) + pad).0)
+    } else {
+        (min, max)
+    }
+}

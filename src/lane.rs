@@ -1,0 +1,190 @@
+//! Lane types: the element-wise float arithmetic every kernel is written over.
+//!
+//! A kernel is written once, generic over a [`Lane`]. Plain `f32` is a lane of width 1
+//! and is the scalar reference. glam's `Vec3A` is a lane of width 3 whose lanes are the
+//! axes of one box. [`Vector`] stacks `N` lanes into the components of an `N`-vector,
+//! so `Vector<f32, 3>` is one box on the scalar path and `Vector<[f32; 8], 3>`-like lane
+//! types are eight boxes at once.
+
+use core::ops::{Add, Mul, Neg, Sub};
+
+use glam::Vec3A;
+
+/// Element-wise IEEE-754 single-precision arithmetic over some number of lanes.
+///
+/// `mul_add` is fused only where the lane type says so at compile time: a default
+/// build never calls `fmaf`.
+pub(crate) trait Lane:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+{
+    /// Every lane set to `x`.
+    fn splat(x: f32) -> Self;
+    /// Lane-wise minimum (NaN handling unspecified: the callers never depend on it).
+    fn min(self, other: Self) -> Self;
+    /// Lane-wise maximum (NaN handling unspecified: the callers never depend on it).
+    fn max(self, other: Self) -> Self;
+    /// Lane-wise absolute value (exact: clears the sign bit).
+    fn abs(self) -> Self;
+    /// `self * b + c`, with one rounding when the lane type fuses, two otherwise.
+    fn mul_add(self, b: Self, c: Self) -> Self;
+    /// Lane-wise `if self >= 0 { if_nonneg } else { otherwise }`.
+    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self;
+}
+
+/// A lane type whose lanes are the components of a vector, able to broadcast one of them.
+pub(crate) trait Axes: Lane {
+    /// The vector with every component equal to component `j` of `self`.
+    fn axis(self, j: usize) -> Self;
+}
+
+impl Lane for f32 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        f32::min(self, other)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // Deliberately unfused: `f32::mul_add` is a libm call without hardware FMA.
+        self * b + c
+    }
+    #[inline(always)]
+    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
+        if self >= 0.0 { if_nonneg } else { otherwise }
+    }
+}
+
+impl Lane for Vec3A {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Vec3A::splat(x)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        Vec3A::min(self, other)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Vec3A::max(self, other)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vec3A::abs(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // glam's `Vec3A::mul_add` calls `fmaf` per component when FMA is not enabled at
+        // compile time; fuse only where the instruction is known to exist.
+        if cfg!(target_feature = "fma") {
+            Vec3A::mul_add(self, b, c)
+        } else {
+            self * b + c
+        }
+    }
+    #[inline(always)]
+    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
+        Vec3A::select(self.cmpge(Vec3A::ZERO), if_nonneg, otherwise)
+    }
+}
+
+impl Axes for Vec3A {
+    #[inline(always)]
+    fn axis(self, j: usize) -> Self {
+        match j {
+            0 => Vec3A::splat(self.x),
+            1 => Vec3A::splat(self.y),
+            _ => Vec3A::splat(self.z),
+        }
+    }
+}
+
+/// An `N`-vector whose components are lanes `L`: component `i` of box lane `k` is
+/// `self.0[i]` lane `k`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Vector<L, const N: usize>(pub [L; N]);
+
+impl<L: Lane, const N: usize> Vector<L, N> {
+    #[inline(always)]
+    fn map2(self, o: Self, f: impl Fn(L, L) -> L) -> Self {
+        Vector(core::array::from_fn(|i| f(self.0[i], o.0[i])))
+    }
+}
+
+impl<L: Lane, const N: usize> Add for Vector<L, N> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.map2(o, |a, b| a + b)
+    }
+}
+
+impl<L: Lane, const N: usize> Sub for Vector<L, N> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.map2(o, |a, b| a - b)
+    }
+}
+
+impl<L: Lane, const N: usize> Mul for Vector<L, N> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, |a, b| a * b)
+    }
+}
+
+impl<L: Lane, const N: usize> Neg for Vector<L, N> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Vector(self.0.map(|a| -a))
+    }
+}
+
+impl<L: Lane, const N: usize> Lane for Vector<L, N> {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Vector([L::splat(x); N])
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        self.map2(other, L::min)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        self.map2(other, L::max)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vector(self.0.map(L::abs))
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        Vector(core::array::from_fn(|i| self.0[i].mul_add(b.0[i], c.0[i])))
+    }
+    #[inline(always)]
+    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
+        Vector(core::array::from_fn(|i| {
+            self.0[i].select_nonneg(if_nonneg.0[i], otherwise.0[i])
+        }))
+    }
+}
+
+impl<L: Lane, const N: usize> Axes for Vector<L, N> {
+    #[inline(always)]
+    fn axis(self, j: usize) -> Self {
+        Vector([self.0[j]; N])
+    }
+}
