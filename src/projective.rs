@@ -59,7 +59,7 @@ impl Aabb3 {
         for (corner, c) in self.corners().into_iter().enumerate() {
             let p = [c.x, c.y, c.z, 1.0].map(f64::from);
             let (w_lo, w_hi) = dot_interval(rows[3], p);
-            if !(w_lo > 0.0) {
+            if w_lo <= 0.0 {
                 let w = (w_lo * 0.5 + w_hi * 0.5) as f32;
                 return Err(TransformError::NonPositiveW { corner, w });
             }

@@ -1,0 +1,147 @@
+//! The single-box contract, checked against the exact oracle for every method, rounding,
+//! dimension and path (glam SIMD and scalar), over every extreme class.
+
+mod cases;
+mod oracle;
+
+use bvkit::method::{TINY_ERROR, TINY_PAD};
+use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
+use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use proptest::prelude::*;
+
+use cases::{Class, problem, rigid_problem, rng};
+use oracle::{Bound, Problem, check};
+
+/// The bound `method` documents for `rounding` in `dims` dimensions.
+fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
+    match rounding {
+        Rounding::Nearest => Bound::Nearest {
+            gamma_n: method.nearest_gamma(dims),
+            tiny: f64::from(TINY_ERROR),
+        },
+        Rounding::Outward => Bound::Outward {
+            k: method.outward_pad(dims),
+            tiny: f64::from(TINY_PAD),
+        },
+    }
+}
+
+fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
+    let [x, y, z] = p.cols.map(Vec3A::from_array);
+    let xf = Affine3A::from_mat3_translation(
+        Mat3A::from_cols(x, y, z).into(),
+        Vec3A::from_array(p.t).into(),
+    );
+    (
+        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
+        xf,
+    )
+}
+
+fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
+    let [x, y] = p.cols.map(Vec2::from_array);
+    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
+    (
+        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
+        xf,
+    )
+}
+
+fn check_affine3(p: &Problem<3>) -> Result<(), String> {
+    let (b, xf) = affine3(p);
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let paths = [
+                ("simd", b.transformed(&xf, method, rounding)),
+                ("scalar", b.transformed_scalar(&xf, method, rounding)),
+            ];
+            for (path, out) in paths {
+                check(
+                    p,
+                    out.min.to_array(),
+                    out.max.to_array(),
+                    bound(method, rounding, 3),
+                )
+                .map_err(|e| format!("{method:?} {rounding:?} {path}: {e}\n{p:?}"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_affine2(p: &Problem<2>) -> Result<(), String> {
+    let (b, xf) = affine2(p);
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let out = b.transformed(&xf, method, rounding);
+            check(
+                p,
+                out.min.to_array(),
+                out.max.to_array(),
+                bound(method, rounding, 2),
+            )
+            .map_err(|e| format!("{method:?} {rounding:?}: {e}\n{p:?}"))?;
+        }
+    }
+    Ok(())
+}
+
+fn check_rigid2(p: &Problem<2>) -> Result<(), String> {
+    let (b, _) = affine2(p);
+    let xf = Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t));
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let out = b.transformed_rigid(&xf, method, rounding);
+            check(
+                p,
+                out.min.to_array(),
+                out.max.to_array(),
+                bound(method, rounding, 2),
+            )
+            .map_err(|e| format!("{method:?} {rounding:?}: {e}\n{p:?}"))?;
+        }
+    }
+    Ok(())
+}
+
+fn class() -> impl Strategy<Value = Class> {
+    proptest::sample::select(Class::ALL.to_vec())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 6000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn affine3_meets_the_contract(class in class(), seed in any::<u64>()) {
+        let p = problem::<3>(class, &mut rng(seed));
+        check_affine3(&p).map_err(TestCaseError::fail)?;
+    }
+
+    #[test]
+    fn affine2_meets_the_contract(class in class(), seed in any::<u64>()) {
+        let p = problem::<2>(class, &mut rng(seed));
+        check_affine2(&p).map_err(TestCaseError::fail)?;
+    }
+
+    #[test]
+    fn rigid2_meets_the_contract(class in class(), seed in any::<u64>()) {
+        let p = rigid_problem(class, &mut rng(seed));
+        check_rigid2(&p).map_err(TestCaseError::fail)?;
+    }
+}
+
+/// Every class, many seeds each: no class is left to the luck of the class draw.
+#[test]
+fn every_class_meets_the_contract() {
+    for class in Class::ALL {
+        for seed in 0..500 {
+            let r = &mut rng(seed ^ (class as u64) << 32);
+            let result = check_affine3(&problem(class, r))
+                .and_then(|()| check_affine2(&problem(class, r)))
+                .and_then(|()| check_rigid2(&rigid_problem(class, r)));
+            if let Err(e) = result {
+                panic!("{class:?} seed {seed}: {e}");
+            }
+        }
+    }
+}
