@@ -1,5 +1,5 @@
 //! Random boxes and transforms, one generator per extreme class of the contract.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use rand::RngExt;
 use rand::SeedableRng;

@@ -5,7 +5,7 @@
 //! integers, summed here without rounding in arbitrary precision. Containment is decided
 //! by exact comparison; errors are measured as exact differences, converted to `f64` only
 //! for reporting against a bound.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
@@ -73,7 +73,7 @@ impl Exact {
         }
         let (sm, em) = decompose(m);
         let (sx, ex) = decompose(x);
-        Exact::Finite(BigInt::from(sm) * BigInt::from(sx) << (em + ex + SCALE) as usize)
+        Exact::Finite((BigInt::from(sm) * BigInt::from(sx)) << (em + ex + SCALE) as usize)
     }
 
     /// The exact sum; `+inf + -inf` has no value and is an oracle misuse.
@@ -257,13 +257,11 @@ fn check_face(
     } else {
         face_exact >= *exact
     };
-    if let Bound::Outward { .. } = bound {
-        if !contains {
-            return Err(format!(
-                "Outward face {face:e} does not contain the exact face {:e}",
-                exact.to_f64()
-            ));
-        }
+    if matches!(bound, Bound::Outward { .. }) && !contains {
+        return Err(format!(
+            "Outward face {face:e} does not contain the exact face {:e}",
+            exact.to_f64()
+        ));
     }
     let allowance = bound.allowance(magnitude);
     match exact {
