@@ -45,6 +45,8 @@ pub(crate) fn transform<const N: usize>(
         let (mut lo_i, mut hi_i) = (ti, ti);
         // Magnitudes of the terms summed into each face: their f64 rounding error bound.
         let (mut lo_mag, mut hi_mag) = (ti.abs(), ti.abs());
+        // Whether every f64 addition was exact: then no pad is needed.
+        let mut exact = true;
         for j in 0..N {
             let m = f64::from(cols[j][i]);
             if m == 0.0 {
@@ -52,6 +54,7 @@ pub(crate) fn transform<const N: usize>(
             }
             let (a, b) = (m * f64::from(lo[j]), m * f64::from(hi[j]));
             let (low, high) = if a <= b { (a, b) } else { (b, a) };
+            exact &= is_exact_sum(lo_i, low) && is_exact_sum(hi_i, high);
             lo_i += low;
             hi_i += high;
             lo_mag += low.abs();
@@ -61,6 +64,7 @@ pub(crate) fn transform<const N: usize>(
         // term is -inf: the sums are never NaN.
         (min[i], max[i]) = match rounding {
             Rounding::Nearest => (lo_i as f32, hi_i as f32),
+            Rounding::Outward if exact => (round_down(lo_i), round_up(hi_i)),
             Rounding::Outward => (
                 round_down(lo_i - lo_mag * F64_SUM_PAD),
                 round_up(hi_i + hi_mag * F64_SUM_PAD),
@@ -68,6 +72,18 @@ pub(crate) fn transform<const N: usize>(
         };
     }
     (min, max)
+}
+
+/// True when `a + b` is exact in `f64` (Knuth's TwoSum error term is zero), or infinite.
+#[inline]
+fn is_exact_sum(a: f64, b: f64) -> bool {
+    let s = a + b;
+    if !s.is_finite() {
+        return true; // an infinite face is exact: no finite term changes it
+    }
+    let b_virtual = s - a;
+    let a_virtual = s - b_virtual;
+    (a - a_virtual) + (b - b_virtual) == 0.0
 }
 
 /// The largest `f32` not above `x` (`-inf` below the range).

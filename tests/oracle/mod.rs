@@ -353,3 +353,34 @@ pub fn check<const N: usize>(
         }
     }
 }
+
+impl Exact {
+    /// The exact dot product `row · p` of `f32` values (no infinities).
+    pub fn dot(row: &[f32], p: &[f32]) -> Exact {
+        row.iter()
+            .zip(p)
+            .fold(Exact::ZERO, |acc, (&m, &x)| acc.add(&Exact::product(m, x)))
+    }
+
+    /// Decides `face · w <= n` exactly, that is `face <= n / w` for `w > 0`.
+    pub fn face_le_ratio(face: f32, n: &Exact, w: &Exact) -> bool {
+        match (Exact::of(face), n, w) {
+            (Exact::Finite(f), Exact::Finite(n), Exact::Finite(w)) => {
+                assert!(w > &BigInt::ZERO);
+                f * w <= n << SCALE as usize
+            }
+            (Exact::NegInf, _, _) => true,
+            (Exact::PosInf, _, _) => false,
+            _ => panic!("face_le_ratio takes finite n and w"),
+        }
+    }
+
+    /// Decides `face >= n / w` exactly for `w > 0`.
+    pub fn face_ge_ratio(face: f32, n: &Exact, w: &Exact) -> bool {
+        let negated = match n {
+            Exact::Finite(n) => Exact::Finite(-n),
+            _ => panic!("face_ge_ratio takes finite n"),
+        };
+        Exact::face_le_ratio(-face, &negated, w)
+    }
+}
