@@ -56,8 +56,14 @@ struct Row {
 
 fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
     match rounding {
-        Rounding::Nearest => Bound::Nearest { gamma_n: method.nearest_gamma(dims), tiny: f64::from(TINY_ERROR) },
-        Rounding::Outward => Bound::Outward { k: method.outward_pad(dims), tiny: f64::from(TINY_PAD) },
+        Rounding::Nearest => Bound::Nearest {
+            gamma_n: method.nearest_gamma(dims),
+            tiny: f64::from(TINY_ERROR),
+        },
+        Rounding::Outward => Bound::Outward {
+            k: method.outward_pad(dims),
+            tiny: f64::from(TINY_PAD),
+        },
     }
 }
 
@@ -90,7 +96,8 @@ fn accuracy<const N: usize>(
         for seed in 0..CASES {
             let p = make(class, SEED ^ seed ^ (class as u64) << 40);
             let (min, max) = kernel(&p);
-            let m: Measured = check(&p, min, max, bound).unwrap_or_else(|e| panic!("contract broken: {e}\n{p:?}"));
+            let m: Measured = check(&p, min, max, bound)
+                .unwrap_or_else(|e| panic!("contract broken: {e}\n{p:?}"));
             worst = worst.max(m.worst_error_us);
             contained += u64::from(m.contains);
             total += 1;
@@ -100,25 +107,42 @@ fn accuracy<const N: usize>(
             }
         }
     }
-    (worst, contained as f64 / total as f64, overhead_sum / overhead_count as f64)
+    (
+        worst,
+        contained as f64 / total as f64,
+        overhead_sum / overhead_count as f64,
+    )
 }
 
 fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
     let [x, y, z] = p.cols.map(Vec3A::from_array);
-    let xf = Affine3A { matrix3: Mat3A::from_cols(x, y, z), translation: Vec3A::from_array(p.t) };
-    (Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)), xf)
+    let xf = Affine3A {
+        matrix3: Mat3A::from_cols(x, y, z),
+        translation: Vec3A::from_array(p.t),
+    };
+    (
+        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
+        xf,
+    )
 }
 
 fn rigid2(p: &Problem<2>) -> (Aabb2, Rigid2) {
     let b = Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi));
-    (b, Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)))
+    (
+        b,
+        Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)),
+    )
 }
 
 fn measure_single() -> Vec<Row> {
     let mut rows = Vec::new();
     let r = &mut rng(SEED);
-    let inputs3: Vec<(Aabb3, Affine3A)> = (0..LOOP).map(|_| affine3(&problem::<3>(Class::Typical, r))).collect();
-    let inputs2: Vec<(Aabb2, Rigid2)> = (0..LOOP).map(|_| rigid2(&rigid_problem(Class::Typical, r))).collect();
+    let inputs3: Vec<(Aabb3, Affine3A)> = (0..LOOP)
+        .map(|_| affine3(&problem::<3>(Class::Typical, r)))
+        .collect();
+    let inputs2: Vec<(Aabb2, Rigid2)> = (0..LOOP)
+        .map(|_| rigid2(&rigid_problem(Class::Typical, r)))
+        .collect();
     let mut out3 = vec![Aabb3::EMPTY; LOOP];
     let mut out2 = vec![Aabb2::EMPTY; LOOP];
     for method in Method::ALL {
@@ -139,7 +163,15 @@ fn measure_single() -> Vec<Row> {
                 },
                 bound(method, rounding, 3),
             );
-            rows.push(Row { kernel: "single 3D affine".into(), method, rounding, ns_per_box: ns, worst_error_us: worst, contains, overhead });
+            rows.push(Row {
+                kernel: "single 3D affine".into(),
+                method,
+                rounding,
+                ns_per_box: ns,
+                worst_error_us: worst,
+                contains,
+                overhead,
+            });
 
             eprintln!("  single 2D rigid {} {}", method.name(), rounding.name());
             let ns = median_ns_per_box(|| {
@@ -157,7 +189,15 @@ fn measure_single() -> Vec<Row> {
                 },
                 bound(method, rounding, 2),
             );
-            rows.push(Row { kernel: "single 2D rigid".into(), method, rounding, ns_per_box: ns, worst_error_us: worst, contains, overhead });
+            rows.push(Row {
+                kernel: "single 2D rigid".into(),
+                method,
+                rounding,
+                ns_per_box: ns,
+                worst_error_us: worst,
+                contains,
+                overhead,
+            });
         }
     }
     rows
@@ -185,7 +225,9 @@ fn table(rows: &[Row]) -> String {
 }
 
 fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("kernel,method,rounding,ns_per_box,worst_error_us,contains_fraction,mean_volume_overhead\n");
+    let mut s = String::from(
+        "kernel,method,rounding,ns_per_box,worst_error_us,contains_fraction,mean_volume_overhead\n",
+    );
     for r in rows {
         writeln!(
             s,
@@ -208,14 +250,22 @@ fn svg(rows: &[Row]) -> String {
     let (w, h, left, right, top, bottom) = (900.0, 560.0, 80.0, 250.0, 40.0, 60.0);
     let (pw, ph) = (w - left - right, h - top - bottom);
     let lx = |ns: f64| ns.max(1e-3).log10();
-    let (x0, x1) = rows.iter().fold((f64::MAX, f64::MIN), |(a, b), r| (a.min(lx(r.ns_per_box)), b.max(lx(r.ns_per_box))));
+    let (x0, x1) = rows.iter().fold((f64::MAX, f64::MIN), |(a, b), r| {
+        (a.min(lx(r.ns_per_box)), b.max(lx(r.ns_per_box)))
+    });
     let (x0, x1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0));
     let y1 = rows.iter().map(|r| r.worst_error_us).fold(1.0, f64::max) * 1.1;
     let px = |ns: f64| left + (lx(ns) - x0) / (x1 - x0) * pw;
     let py = |e: f64| top + ph - e / y1 * ph;
-    let mut s = format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#);
+    let mut s = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#
+    );
     write!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#).unwrap();
-    write!(s, r#"<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#).unwrap();
+    write!(
+        s,
+        r#"<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
+    )
+    .unwrap();
     let mut decade = x0;
     while decade <= x1 {
         let x = left + (decade - x0) / (x1 - x0) * pw;
@@ -224,9 +274,21 @@ fn svg(rows: &[Row]) -> String {
     }
     for k in 0..=5 {
         let e = y1 * f64::from(k) / 5.0;
-        write!(s, r#"<text x="{}" y="{}" text-anchor="end">{e:.1}</text>"#, left - 6.0, py(e) + 4.0).unwrap();
+        write!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="end">{e:.1}</text>"#,
+            left - 6.0,
+            py(e) + 4.0
+        )
+        .unwrap();
     }
-    write!(s, r#"<text x="{}" y="{}" text-anchor="middle">ns per box (median, log scale)</text>"#, left + pw / 2.0, h - 15.0).unwrap();
+    write!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle">ns per box (median, log scale)</text>"#,
+        left + pw / 2.0,
+        h - 15.0
+    )
+    .unwrap();
     write!(s, r#"<text x="18" y="{}" transform="rotate(-90 18 {})" text-anchor="middle">worst face error (u·S)</text>"#, top + ph / 2.0, top + ph / 2.0).unwrap();
     let color = |m: Method| match m {
         Method::Naive => "#d62728",
@@ -242,15 +304,35 @@ fn svg(rows: &[Row]) -> String {
         }
         .unwrap();
         let ly = top + 14.0 + 16.0 * i as f64;
-        write!(s, r#"<text x="{}" y="{ly}" fill="{c}">{}: {} {} ({:.2} ns, {:.2} u·S)</text>"#, left + pw + 10.0, i + 1, r.kernel, format_args!("{} {}", r.method.name(), r.rounding.name()), r.ns_per_box, r.worst_error_us).unwrap();
-        write!(s, r#"<text x="{:.1}" y="{:.1}" font-size="10">{}</text>"#, x + 7.0, y - 6.0, i + 1).unwrap();
+        write!(
+            s,
+            r#"<text x="{}" y="{ly}" fill="{c}">{}: {} {} ({:.2} ns, {:.2} u·S)</text>"#,
+            left + pw + 10.0,
+            i + 1,
+            r.kernel,
+            format_args!("{} {}", r.method.name(), r.rounding.name()),
+            r.ns_per_box,
+            r.worst_error_us
+        )
+        .unwrap();
+        write!(
+            s,
+            r#"<text x="{:.1}" y="{:.1}" font-size="10">{}</text>"#,
+            x + 7.0,
+            y - 6.0,
+            i + 1
+        )
+        .unwrap();
     }
     s.push_str("</svg>\n");
     s
 }
 
 fn main() -> std::io::Result<()> {
-    eprintln!("bvkit trade report: timing {LOOP}-box loops ({REPS} reps, median) and checking {} oracle cases per kernel", CASES * ACCURACY_CLASSES.len() as u64);
+    eprintln!(
+        "bvkit trade report: timing {LOOP}-box loops ({REPS} reps, median) and checking {} oracle cases per kernel",
+        CASES * ACCURACY_CLASSES.len() as u64
+    );
     let rows = measure_single();
     println!("## Single boxes\n");
     println!("{}", table(&rows));
@@ -259,11 +341,17 @@ fn main() -> std::io::Result<()> {
         CASES * ACCURACY_CLASSES.len() as u64,
         ACCURACY_CLASSES
     );
-    let dir = PathBuf::from(std::env::var_os("CARGO_TARGET_DIR").unwrap_or_else(|| "target".into())).join("trade");
+    let dir =
+        PathBuf::from(std::env::var_os("CARGO_TARGET_DIR").unwrap_or_else(|| "target".into()))
+            .join("trade");
     std::fs::create_dir_all(&dir)?;
     let (csv_path, svg_path) = (dir.join("trade.csv"), dir.join("trade.svg"));
     std::fs::write(&csv_path, csv(&rows))?;
     std::fs::write(&svg_path, svg(&rows))?;
-    println!("\nwrote {}\nwrote {}", csv_path.display(), svg_path.display());
+    println!(
+        "\nwrote {}\nwrote {}",
+        csv_path.display(),
+        svg_path.display()
+    );
     Ok(())
 }

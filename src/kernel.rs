@@ -57,9 +57,9 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 pub(crate) fn abs_matrix<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V) -> (V, V) {
     let center2 = lo + hi;
     let extent2 = hi - lo;
-    let mut world_center2 = a.t + a.t;
-    let mut world_extent2 = V::splat(0.0);
-    for j in 0..N {
+    let mut world_center2 = a.cols[0].mul_add(center2.axis(0), a.t + a.t);
+    let mut world_extent2 = a.cols[0].abs() * extent2.axis(0);
+    for j in 1..N {
         world_center2 = a.cols[j].mul_add(center2.axis(j), world_center2);
         world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
     }

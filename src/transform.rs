@@ -92,7 +92,10 @@ impl Aabb3 {
         };
         let outward = rounding == Rounding::Outward;
         let (min, max) = kernel::transform(&a, self.min, self.max, method, outward);
-        if self.min.cmple(self.max).all() && min.is_finite() && max.is_finite() {
+        // One mask, one branch: non-empty, NaN-free input, and a finite result (`x·0` is
+        // 0 for finite `x`, NaN for `±inf` and NaN).
+        let finite = (min * 0.0 + max * 0.0).cmpeq(Vec3A::ZERO);
+        if (self.min.cmple(self.max) & finite).all() {
             Aabb3 { min, max }
         } else {
             self.transformed_extended(xf, rounding)
