@@ -61,7 +61,9 @@ impl Lane for f32 {
     }
     #[inline(always)]
     fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
-        if self >= 0.0 { if_nonneg } else { otherwise }
+        // Branch-free: a sign test on random rotations mispredicts half the time.
+        let keep = u32::from(self >= 0.0).wrapping_neg();
+        f32::from_bits(if_nonneg.to_bits() & keep | otherwise.to_bits() & !keep)
     }
 }
 
