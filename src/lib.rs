@@ -33,9 +33,11 @@
 //!   `NAN` box; unbounded faces to the exact unbounded result (a zero entry contributes
 //!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
 #![deny(missing_docs)]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 mod aabb;
+mod batch;
+mod block;
 mod error;
 mod extended;
 mod kernel;
@@ -43,11 +45,17 @@ mod lane;
 pub mod method;
 mod projective;
 mod rigid2;
+mod simd;
 mod transform;
 
 pub use aabb::{Aabb2, Aabb3};
+pub use batch::{
+    Aabb3x8, AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef, Affine3x8, Batch,
+    BatchError, transform_slice,
+};
 pub use error::TransformError;
 pub use method::{Method, Rounding};
 pub use rigid2::Rigid2;
+pub use simd::Backend;
 
 pub use glam;

@@ -9,6 +9,7 @@
 use glam::{Affine2, Affine3A, Mat4, Vec2, Vec3A};
 
 use crate::aabb::{Aabb2, Aabb3};
+use crate::block::{self, Rigid2Lanes};
 use crate::error::TransformError;
 use crate::extended;
 use crate::kernel::{self, AffineLanes};
@@ -22,18 +23,6 @@ const GLAM_SIMD: bool = cfg!(any(
     all(target_arch = "aarch64", target_feature = "neon"),
     target_feature = "simd128"
 ));
-
-/// True when the fast path's result stands: the box is non-empty with no NaN (every
-/// `lo <= hi`) and every face came out finite.
-#[inline(always)]
-fn fast_path_holds<const N: usize>(
-    lo: [f32; N],
-    hi: [f32; N],
-    min: [f32; N],
-    max: [f32; N],
-) -> bool {
-    (0..N).all(|j| lo[j] <= hi[j] && min[j].is_finite() && max[j].is_finite())
-}
 
 /// The box `[lo, hi]` through `x ↦ M x + t` on the scalar path (`cols[j][i] = m_ij`).
 #[inline(always)]
@@ -49,13 +38,8 @@ fn transform_scalar<const N: usize>(
         cols: cols.map(Vector),
         t: Vector(t),
     };
-    let outward = rounding == Rounding::Outward;
-    let (min, max) = kernel::transform(&a, Vector(lo), Vector(hi), method, outward);
-    if fast_path_holds(lo, hi, min.0, max.0) {
-        (min.0, max.0)
-    } else {
-        extended::transform(cols, t, lo, hi, rounding)
-    }
+    let (min, max) = block::transform::<f32, N, _>(&a, Vector(lo), Vector(hi), method, rounding);
+    (min.0, max.0)
 }
 
 fn affine3_cols(xf: &Affine3A) -> [[f32; 3]; 3] {
@@ -158,10 +142,6 @@ fn affine2_cols(xf: &Affine2) -> [[f32; 2]; 2] {
     [xf.matrix2.x_axis.to_array(), xf.matrix2.y_axis.to_array()]
 }
 
-fn rigid2_cols(xf: &Rigid2) -> [[f32; 2]; 2] {
-    [[xf.cos, xf.sin], [-xf.sin, xf.cos]]
-}
-
 impl Aabb2 {
     /// The box through `xf` by `method`, with the guarantee `rounding` gives.
     ///
@@ -189,16 +169,14 @@ impl Aabb2 {
     #[inline]
     #[must_use]
     pub fn transformed_rigid(&self, xf: &Rigid2, method: Method, rounding: Rounding) -> Aabb2 {
-        let (lo, hi) = (self.min.to_array(), self.max.to_array());
-        let t = xf.translation.to_array();
-        let cols = rigid2_cols(xf);
-        let outward = rounding == Rounding::Outward;
-        let (min, max) = kernel::transform_rigid2(xf.cos, xf.sin, t, lo, hi, method, outward);
-        let (min, max) = if fast_path_holds(lo, hi, min, max) {
-            (min, max)
-        } else {
-            extended::transform(cols, t, lo, hi, rounding)
+        let map = Rigid2Lanes {
+            cos: xf.cos,
+            sin: xf.sin,
+            t: xf.translation.to_array(),
         };
+        let (lo, hi) = (Vector(self.min.to_array()), Vector(self.max.to_array()));
+        let (min, max) = block::transform(&map, lo, hi, method, rounding);
+        let (min, max) = (min.0, max.0);
         Aabb2::new(Vec2::from_array(min), Vec2::from_array(max))
     }
 }

@@ -1,0 +1,143 @@
+//! Backends and run-time dispatch.
+//!
+//! A batch job is written once, generic over a lane type ([`Job::run`]). Dispatch picks the
+//! lane type for the chosen [`Backend`] and, for AVX2+FMA and AVX-512, instantiates the job
+//! inside a `#[target_feature]` wrapper so that the plain array code is compiled for those
+//! instructions, although the crate itself is built for the baseline target. The best
+//! backend of the running CPU is detected once and cached.
+
+mod lanes;
+
+use std::sync::OnceLock;
+
+pub(crate) use lanes::{F32s, LaneArray};
+
+/// A code path for the batch kernels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Backend {
+    /// One box at a time in plain `f32`: the reference every other backend is tested against.
+    Scalar,
+    /// Portable lane arrays of 8, compiled for the build's baseline (SSE2 on x86-64, NEON
+    /// on aarch64).
+    Baseline,
+    /// Lane arrays of 8 compiled for AVX2 with FMA, chosen at run time (x86-64).
+    Avx2,
+    /// Lane arrays of 16 compiled for AVX-512F with FMA, chosen at run time (x86-64).
+    Avx512,
+    /// `wide::f32x8`: its instructions fixed at compile time by the build's target
+    /// features (two SSE halves on a default x86-64 build, AVX with `target-cpu=native`).
+    Wide,
+}
+
+impl Backend {
+    /// Every backend, in order of preference from the least to the most capable.
+    pub const ALL: [Backend; 5] = [
+        Backend::Scalar,
+        Backend::Wide,
+        Backend::Baseline,
+        Backend::Avx2,
+        Backend::Avx512,
+    ];
+
+    /// True when the running CPU can execute this backend.
+    #[must_use]
+    pub fn is_supported(self) -> bool {
+        match self {
+            Backend::Scalar | Backend::Baseline | Backend::Wide => true,
+            #[cfg(target_arch = "x86_64")]
+            Backend::Avx2 => {
+                std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(target_arch = "x86_64")]
+            Backend::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            Backend::Avx2 | Backend::Avx512 => false,
+        }
+    }
+
+    /// The backends the running CPU supports, from the least to the most capable.
+    #[must_use]
+    pub fn supported() -> Vec<Backend> {
+        Backend::ALL
+            .into_iter()
+            .filter(|b| b.is_supported())
+            .collect()
+    }
+
+    /// The fastest supported backend, detected on first use and cached.
+    #[must_use]
+    pub fn detect() -> Backend {
+        static DETECTED: OnceLock<Backend> = OnceLock::new();
+        *DETECTED.get_or_init(|| {
+            [Backend::Avx512, Backend::Avx2, Backend::Baseline]
+                .into_iter()
+                .find(|b| b.is_supported())
+                .unwrap_or(Backend::Scalar)
+        })
+    }
+
+    /// Boxes per lane block.
+    #[must_use]
+    pub const fn lanes(self) -> usize {
+        match self {
+            Backend::Scalar => 1,
+            Backend::Baseline | Backend::Avx2 | Backend::Wide => 8,
+            Backend::Avx512 => 16,
+        }
+    }
+
+    /// A short lower-case name, for tables.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Backend::Scalar => "scalar",
+            Backend::Baseline => "baseline",
+            Backend::Avx2 => "avx2",
+            Backend::Avx512 => "avx512",
+            Backend::Wide => "wide",
+        }
+    }
+}
+
+/// A batch job, written once over a lane type.
+pub(crate) trait Job {
+    /// Runs the job with lanes `L`; implementations are `#[inline(always)]` so that they
+    /// compile for the target features of the dispatch wrapper that calls them.
+    fn run<L: LaneArray>(self);
+}
+
+/// Runs `job` on `backend`, which the caller has checked is supported.
+#[allow(unsafe_code)] // the one place: calling the `#[target_feature]` wrappers
+pub(crate) fn dispatch<J: Job>(backend: Backend, job: J) {
+    debug_assert!(backend.is_supported());
+    match backend {
+        Backend::Scalar => job.run::<f32>(),
+        Backend::Baseline => job.run::<F32s<8, false>>(),
+        Backend::Wide => job.run::<wide::f32x8>(),
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has AVX2 and FMA.
+        Backend::Avx2 => unsafe { run_avx2(job) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has
+        // AVX-512F and FMA.
+        Backend::Avx512 => unsafe { run_avx512(job) },
+        #[cfg(not(target_arch = "x86_64"))]
+        Backend::Avx2 | Backend::Avx512 => job.run::<F32s<8, false>>(),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn run_avx2<J: Job>(job: J) {
+    job.run::<F32s<8, true>>();
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx2,fma")]
+fn run_avx512<J: Job>(job: J) {
+    job.run::<F32s<16, true>>();
+}
