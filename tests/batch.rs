@@ -152,7 +152,7 @@ fn every_3d_layout_on_every_backend() {
         } else {
             len
         };
-        let ps = problems::<3>(len, 100 + n as u64, |c, r| problem(c, r));
+        let ps = problems::<3>(len, 100 + n as u64, problem);
         let (local, xfs): (Vec<Aabb3>, Vec<Affine3A>) = ps.iter().map(affine3).unzip();
         let shared = xfs.first().copied().unwrap_or(Affine3A::IDENTITY);
         let shared_ps: Vec<Problem<3>> = ps
@@ -293,8 +293,8 @@ fn every_2d_layout_on_every_backend() {
         } else {
             len
         };
-        let ps = problems::<2>(len, 200 + n as u64, |c, r| problem(c, r));
-        let rps = problems::<2>(len, 300 + n as u64, |c, r| rigid_problem(c, r));
+        let ps = problems::<2>(len, 200 + n as u64, problem);
+        let rps = problems::<2>(len, 300 + n as u64, rigid_problem);
         let (local, xfs): (Vec<Aabb2>, Vec<Affine2>) = ps.iter().map(affine2).unzip();
         let rlocal: Vec<Aabb2> = rps.iter().map(|p| affine2(p).0).collect();
         let rigid: Vec<Rigid2> = rps
