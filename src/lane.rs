@@ -117,9 +117,23 @@ impl Axes for Vec3A {
 pub(crate) struct Vector<L, const N: usize>(pub [L; N]);
 
 impl<L: Lane, const N: usize> Vector<L, N> {
+    // Indexed loops rather than `array::from_fn`/`map`: their closures and internal
+    // adapters are not always inlined into a hot loop, and an outlined call there stops
+    // LLVM from vectorising the kernel.
     #[inline(always)]
-    fn map2(self, o: Self, f: impl Fn(L, L) -> L) -> Self {
-        Vector(core::array::from_fn(|i| f(self.0[i], o.0[i])))
+    fn map2(mut self, o: Self, f: impl Fn(L, L) -> L) -> Self {
+        for i in 0..N {
+            self.0[i] = f(self.0[i], o.0[i]);
+        }
+        self
+    }
+
+    #[inline(always)]
+    fn map1(mut self, f: impl Fn(L) -> L) -> Self {
+        for i in 0..N {
+            self.0[i] = f(self.0[i]);
+        }
+        self
     }
 }
 
@@ -151,7 +165,7 @@ impl<L: Lane, const N: usize> Neg for Vector<L, N> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
-        Vector(self.0.map(|a| -a))
+        self.map1(|a| -a)
     }
 }
 
@@ -170,17 +184,21 @@ impl<L: Lane, const N: usize> Lane for Vector<L, N> {
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        Vector(self.0.map(L::abs))
+        self.map1(L::abs)
     }
     #[inline(always)]
-    fn mul_add(self, b: Self, c: Self) -> Self {
-        Vector(core::array::from_fn(|i| self.0[i].mul_add(b.0[i], c.0[i])))
+    fn mul_add(self, b: Self, mut c: Self) -> Self {
+        for i in 0..N {
+            c.0[i] = self.0[i].mul_add(b.0[i], c.0[i]);
+        }
+        c
     }
     #[inline(always)]
-    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
-        Vector(core::array::from_fn(|i| {
-            self.0[i].select_nonneg(if_nonneg.0[i], otherwise.0[i])
-        }))
+    fn select_nonneg(self, if_nonneg: Self, mut otherwise: Self) -> Self {
+        for i in 0..N {
+            otherwise.0[i] = self.0[i].select_nonneg(if_nonneg.0[i], otherwise.0[i]);
+        }
+        otherwise
     }
 }
 

@@ -38,8 +38,11 @@ fn transform_scalar<const N: usize>(
         cols: cols.map(Vector),
         t: Vector(t),
     };
-    let (min, max) = block::transform::<f32, N, _>(&a, Vector(lo), Vector(hi), method, rounding);
-    (min.0, max.0)
+    let outward = rounding == Rounding::Outward;
+    match block::transform::<f32, N, _>(&a, Vector(lo), Vector(hi), method, outward) {
+        (min, max, 0.0) => (min.0, max.0),
+        _ => extended::transform(cols, t, lo, hi, rounding),
+    }
 }
 
 fn affine3_cols(xf: &Affine3A) -> [[f32; 3]; 3] {
@@ -138,6 +141,10 @@ impl Aabb3 {
     }
 }
 
+fn rigid2_cols(xf: &Rigid2) -> [[f32; 2]; 2] {
+    [[xf.cos, xf.sin], [-xf.sin, xf.cos]]
+}
+
 fn affine2_cols(xf: &Affine2) -> [[f32; 2]; 2] {
     [xf.matrix2.x_axis.to_array(), xf.matrix2.y_axis.to_array()]
 }
@@ -174,9 +181,12 @@ impl Aabb2 {
             sin: xf.sin,
             t: xf.translation.to_array(),
         };
-        let (lo, hi) = (Vector(self.min.to_array()), Vector(self.max.to_array()));
-        let (min, max) = block::transform(&map, lo, hi, method, rounding);
-        let (min, max) = (min.0, max.0);
+        let (lo, hi) = (self.min.to_array(), self.max.to_array());
+        let outward = rounding == Rounding::Outward;
+        let (min, max) = match block::transform(&map, Vector(lo), Vector(hi), method, outward) {
+            (min, max, 0.0) => (min.0, max.0),
+            _ => extended::transform(rigid2_cols(xf), map.t, lo, hi, rounding),
+        };
         Aabb2::new(Vec2::from_array(min), Vec2::from_array(max))
     }
 }

@@ -1,13 +1,17 @@
 //! AoS slices (`&[Aabb3]`, `&[Affine3A]`, 2D `&[Aabb2]`, `&[Affine2]`, `&[Rigid2]`) and
 //! shared transforms, as lanes.
+//!
+//! Loaders run over every lane with a constant index (`k < count` masks the tail), so
+//! that the lane arrays stay in registers and the main loop, where `count` is the lane
+//! width, has no mask at all.
 
 use glam::{Affine2, Affine3A, Vec2, Vec3A};
 
 use super::{BatchError, BoxSink, BoxSource, MapSource};
 use crate::aabb::{Aabb2, Aabb3};
-use crate::block::{Rigid2Lanes, gather, splat};
+use crate::block::{Rigid2Lanes, splat};
 use crate::kernel::AffineLanes;
-use crate::lane::Vector;
+use crate::lane::{Lane, Vector};
 use crate::rigid2::Rigid2;
 use crate::simd::LaneArray;
 
@@ -17,14 +21,20 @@ impl BoxSource<3> for &[Aabb3] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
-        (
-            Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].min[a])
-            })),
-            Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].max[a])
-            })),
-        )
+        let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
+        for k in 0..L::WIDTH {
+            if k < count {
+                let b = &self[i + k];
+                for a in 0..3 {
+                    lo.0[a].set(k, b.min[a]);
+                    hi.0[a].set(k, b.max[a]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+    fn get(&self, i: usize) -> ([f32; 3], [f32; 3]) {
+        (self[i].min.to_array(), self[i].max.to_array())
     }
 }
 
@@ -40,10 +50,16 @@ impl BoxSink<3> for &mut [Aabb3] {
         min: Vector<L, 3>,
         max: Vector<L, 3>,
     ) {
-        for (k, out) in self[i..i + count].iter_mut().enumerate() {
-            let lane = |v: &Vector<L, 3>| Vec3A::from_array(v.0.map(|x| x.get(k)));
-            *out = Aabb3::new(lane(&min), lane(&max));
+        for k in 0..L::WIDTH {
+            if k < count {
+                let lane =
+                    |v: &Vector<L, 3>| Vec3A::new(v.0[0].get(k), v.0[1].get(k), v.0[2].get(k));
+                self[i + k] = Aabb3::new(lane(&min), lane(&max));
+            }
         }
+    }
+    fn set(&mut self, i: usize, min: [f32; 3], max: [f32; 3]) {
+        self[i] = Aabb3::new(Vec3A::from_array(min), Vec3A::from_array(max));
     }
 }
 
@@ -54,17 +70,38 @@ impl MapSource<3> for &[Affine3A] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        AffineLanes {
-            cols: core::array::from_fn(|j| {
-                Vector(core::array::from_fn(|a| {
-                    gather(i, count, |b| self[b].matrix3.col(j)[a])
-                }))
-            }),
-            t: Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].translation[a])
-            })),
+        let mut map = AffineLanes {
+            cols: [Vector::<L, 3>::splat(0.0); 3],
+            t: Vector::splat(0.0),
+        };
+        for k in 0..L::WIDTH {
+            if k < count {
+                let xf = &self[i + k];
+                for a in 0..3 {
+                    for j in 0..3 {
+                        map.cols[j].0[a].set(k, xf.matrix3.col(j)[a]);
+                    }
+                    map.t.0[a].set(k, xf.translation[a]);
+                }
+            }
         }
+        map
     }
+    fn get(&self, i: usize) -> ([[f32; 3]; 3], [f32; 3]) {
+        affine3_parts(&self[i])
+    }
+}
+
+fn affine3_parts(xf: &Affine3A) -> ([[f32; 3]; 3], [f32; 3]) {
+    let m = &xf.matrix3;
+    (
+        [
+            m.x_axis.to_array(),
+            m.y_axis.to_array(),
+            m.z_axis.to_array(),
+        ],
+        xf.translation.to_array(),
+    )
 }
 
 impl MapSource<3> for &Affine3A {
@@ -74,10 +111,18 @@ impl MapSource<3> for &Affine3A {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, _: usize, _: usize) -> Self::Lanes<L> {
+        let col = |c: Vec3A| Vector([splat(c.x), splat(c.y), splat(c.z)]);
         AffineLanes {
-            cols: core::array::from_fn(|j| Vector(self.matrix3.col(j).to_array().map(splat))),
-            t: Vector(self.translation.to_array().map(splat)),
+            cols: [
+                col(self.matrix3.x_axis),
+                col(self.matrix3.y_axis),
+                col(self.matrix3.z_axis),
+            ],
+            t: col(self.translation),
         }
+    }
+    fn get(&self, _: usize) -> ([[f32; 3]; 3], [f32; 3]) {
+        affine3_parts(self)
     }
 }
 
@@ -87,14 +132,20 @@ impl BoxSource<2> for &[Aabb2] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 2>, Vector<L, 2>) {
-        (
-            Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].min[a])
-            })),
-            Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].max[a])
-            })),
-        )
+        let (mut lo, mut hi) = (Vector::<L, 2>::splat(0.0), Vector::<L, 2>::splat(0.0));
+        for k in 0..L::WIDTH {
+            if k < count {
+                let b = &self[i + k];
+                for a in 0..2 {
+                    lo.0[a].set(k, b.min[a]);
+                    hi.0[a].set(k, b.max[a]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+    fn get(&self, i: usize) -> ([f32; 2], [f32; 2]) {
+        (self[i].min.to_array(), self[i].max.to_array())
     }
 }
 
@@ -110,10 +161,15 @@ impl BoxSink<2> for &mut [Aabb2] {
         min: Vector<L, 2>,
         max: Vector<L, 2>,
     ) {
-        for (k, out) in self[i..i + count].iter_mut().enumerate() {
-            let lane = |v: &Vector<L, 2>| Vec2::from_array(v.0.map(|x| x.get(k)));
-            *out = Aabb2::new(lane(&min), lane(&max));
+        for k in 0..L::WIDTH {
+            if k < count {
+                let lane = |v: &Vector<L, 2>| Vec2::new(v.0[0].get(k), v.0[1].get(k));
+                self[i + k] = Aabb2::new(lane(&min), lane(&max));
+            }
         }
+    }
+    fn set(&mut self, i: usize, min: [f32; 2], max: [f32; 2]) {
+        self[i] = Aabb2::new(Vec2::from_array(min), Vec2::from_array(max));
     }
 }
 
@@ -124,17 +180,33 @@ impl MapSource<2> for &[Affine2] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        AffineLanes {
-            cols: core::array::from_fn(|j| {
-                Vector(core::array::from_fn(|a| {
-                    gather(i, count, |b| self[b].matrix2.col(j)[a])
-                }))
-            }),
-            t: Vector(core::array::from_fn(|a| {
-                gather(i, count, |b| self[b].translation[a])
-            })),
+        let mut map = AffineLanes {
+            cols: [Vector::<L, 2>::splat(0.0); 2],
+            t: Vector::splat(0.0),
+        };
+        for k in 0..L::WIDTH {
+            if k < count {
+                let xf = &self[i + k];
+                for a in 0..2 {
+                    for j in 0..2 {
+                        map.cols[j].0[a].set(k, xf.matrix2.col(j)[a]);
+                    }
+                    map.t.0[a].set(k, xf.translation[a]);
+                }
+            }
         }
+        map
     }
+    fn get(&self, i: usize) -> ([[f32; 2]; 2], [f32; 2]) {
+        affine2_parts(&self[i])
+    }
+}
+
+fn affine2_parts(xf: &Affine2) -> ([[f32; 2]; 2], [f32; 2]) {
+    (
+        [xf.matrix2.x_axis.to_array(), xf.matrix2.y_axis.to_array()],
+        xf.translation.to_array(),
+    )
 }
 
 impl MapSource<2> for &Affine2 {
@@ -144,11 +216,22 @@ impl MapSource<2> for &Affine2 {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, _: usize, _: usize) -> Self::Lanes<L> {
+        let col = |c: Vec2| Vector([splat(c.x), splat(c.y)]);
         AffineLanes {
-            cols: core::array::from_fn(|j| Vector(self.matrix2.col(j).to_array().map(splat))),
-            t: Vector(self.translation.to_array().map(splat)),
+            cols: [col(self.matrix2.x_axis), col(self.matrix2.y_axis)],
+            t: col(self.translation),
         }
     }
+    fn get(&self, _: usize) -> ([[f32; 2]; 2], [f32; 2]) {
+        affine2_parts(self)
+    }
+}
+
+fn rigid2_parts(xf: &Rigid2) -> ([[f32; 2]; 2], [f32; 2]) {
+    (
+        [[xf.cos, xf.sin], [-xf.sin, xf.cos]],
+        xf.translation.to_array(),
+    )
 }
 
 impl MapSource<2> for &[Rigid2] {
@@ -158,11 +241,25 @@ impl MapSource<2> for &[Rigid2] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        Rigid2Lanes {
-            cos: gather(i, count, |b| self[b].cos),
-            sin: gather(i, count, |b| self[b].sin),
-            t: core::array::from_fn(|a| gather(i, count, |b| self[b].translation[a])),
+        let zero: L = splat(0.0);
+        let mut map = Rigid2Lanes {
+            cos: zero,
+            sin: zero,
+            t: [zero; 2],
+        };
+        for k in 0..L::WIDTH {
+            if k < count {
+                let xf = &self[i + k];
+                map.cos.set(k, xf.cos);
+                map.sin.set(k, xf.sin);
+                map.t[0].set(k, xf.translation.x);
+                map.t[1].set(k, xf.translation.y);
+            }
         }
+        map
+    }
+    fn get(&self, i: usize) -> ([[f32; 2]; 2], [f32; 2]) {
+        rigid2_parts(&self[i])
     }
 }
 
@@ -176,7 +273,10 @@ impl MapSource<2> for &Rigid2 {
         Rigid2Lanes {
             cos: splat(self.cos),
             sin: splat(self.sin),
-            t: self.translation.to_array().map(splat),
+            t: [splat(self.translation.x), splat(self.translation.y)],
         }
+    }
+    fn get(&self, _: usize) -> ([[f32; 2]; 2], [f32; 2]) {
+        rigid2_parts(self)
     }
 }

@@ -6,7 +6,7 @@ use glam::{Affine3A, Mat3A, Vec3A};
 use super::{BatchError, BoxSink, BoxSource, MapSource};
 use crate::aabb::Aabb3;
 use crate::kernel::AffineLanes;
-use crate::lane::Vector;
+use crate::lane::{Lane, Vector};
 use crate::simd::LaneArray;
 
 /// Eight 3D boxes, field by field: `min[axis][box]`, `max[axis][box]` (6 × `[f32; 8]`).
@@ -162,21 +162,12 @@ impl From<Affine3x8> for [Affine3A; 8] {
     }
 }
 
-/// Lanes `i..i + count` of field `field(block)` across consecutive blocks.
+/// True when lanes `i..i + count` fill a whole lane block that lies inside one AoSoA
+/// block (`i` is a multiple of the lane width, which divides 8): then each field is one
+/// vector load. Otherwise (the tail, or 16 lanes spanning two blocks) lanes go one by one.
 #[inline(always)]
-fn lanes<L: LaneArray, T>(
-    blocks: &[T],
-    i: usize,
-    count: usize,
-    field: impl Fn(&T) -> &[f32; 8],
-) -> L {
-    L::from_fn(|k| {
-        if k < count {
-            field(&blocks[(i + k) / 8])[(i + k) % 8]
-        } else {
-            0.0
-        }
-    })
+fn whole<L: LaneArray>(count: usize) -> bool {
+    count == L::WIDTH && 8 % L::WIDTH == 0
 }
 
 impl BoxSource<3> for &[Aabb3x8] {
@@ -185,14 +176,32 @@ impl BoxSource<3> for &[Aabb3x8] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
-        (
-            Vector(core::array::from_fn(|a| {
-                lanes(self, i, count, |b| &b.min[a])
-            })),
-            Vector(core::array::from_fn(|a| {
-                lanes(self, i, count, |b| &b.max[a])
-            })),
-        )
+        if whole::<L>(count) {
+            let (block, slot) = (&self[i / 8], i % 8);
+            let field = |f: &[[f32; 8]; 3]| {
+                Vector([
+                    L::load(&f[0][slot..]),
+                    L::load(&f[1][slot..]),
+                    L::load(&f[2][slot..]),
+                ])
+            };
+            return (field(&block.min), field(&block.max));
+        }
+        let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
+        for k in 0..L::WIDTH {
+            if k < count {
+                let (block, slot) = (&self[(i + k) / 8], (i + k) % 8);
+                for a in 0..3 {
+                    lo.0[a].set(k, block.min[a][slot]);
+                    hi.0[a].set(k, block.max[a][slot]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+    fn get(&self, i: usize) -> ([f32; 3], [f32; 3]) {
+        let b = self[i / 8].get(i % 8);
+        (b.min.to_array(), b.max.to_array())
     }
 }
 
@@ -208,13 +217,29 @@ impl BoxSink<3> for &mut [Aabb3x8] {
         min: Vector<L, 3>,
         max: Vector<L, 3>,
     ) {
-        for k in 0..count {
-            let block = &mut self[(i + k) / 8];
+        if whole::<L>(count) {
+            let (block, slot) = (&mut self[i / 8], i % 8);
             for a in 0..3 {
-                block.min[a][(i + k) % 8] = min.0[a].get(k);
-                block.max[a][(i + k) % 8] = max.0[a].get(k);
+                min.0[a].store(&mut block.min[a][slot..]);
+                max.0[a].store(&mut block.max[a][slot..]);
+            }
+            return;
+        }
+        for k in 0..L::WIDTH {
+            if k < count {
+                let (block, slot) = (&mut self[(i + k) / 8], (i + k) % 8);
+                for a in 0..3 {
+                    block.min[a][slot] = min.0[a].get(k);
+                    block.max[a][slot] = max.0[a].get(k);
+                }
             }
         }
+    }
+    fn set(&mut self, i: usize, min: [f32; 3], max: [f32; 3]) {
+        self[i / 8].set(
+            i % 8,
+            Aabb3::new(Vec3A::from_array(min), Vec3A::from_array(max)),
+        );
     }
 }
 
@@ -225,15 +250,47 @@ impl MapSource<3> for &[Affine3x8] {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        AffineLanes {
-            cols: core::array::from_fn(|j| {
-                Vector(core::array::from_fn(|a| {
-                    lanes(self, i, count, |b| &b.cols[j][a])
-                }))
-            }),
-            t: Vector(core::array::from_fn(|a| {
-                lanes(self, i, count, |b| &b.translation[a])
-            })),
+        if whole::<L>(count) {
+            let (block, slot) = (&self[i / 8], i % 8);
+            let field = |f: &[[f32; 8]; 3]| {
+                Vector([
+                    L::load(&f[0][slot..]),
+                    L::load(&f[1][slot..]),
+                    L::load(&f[2][slot..]),
+                ])
+            };
+            return AffineLanes {
+                cols: [
+                    field(&block.cols[0]),
+                    field(&block.cols[1]),
+                    field(&block.cols[2]),
+                ],
+                t: field(&block.translation),
+            };
         }
+        let mut map = AffineLanes {
+            cols: [Vector::<L, 3>::splat(0.0); 3],
+            t: Vector::splat(0.0),
+        };
+        for k in 0..L::WIDTH {
+            if k < count {
+                let (block, slot) = (&self[(i + k) / 8], (i + k) % 8);
+                for a in 0..3 {
+                    for j in 0..3 {
+                        map.cols[j].0[a].set(k, block.cols[j][a][slot]);
+                    }
+                    map.t.0[a].set(k, block.translation[a][slot]);
+                }
+            }
+        }
+        map
+    }
+    fn get(&self, i: usize) -> ([[f32; 3]; 3], [f32; 3]) {
+        let block = &self[i / 8];
+        let slot = i % 8;
+        (
+            block.cols.map(|c| c.map(|row| row[slot])),
+            block.translation.map(|row| row[slot]),
+        )
     }
 }

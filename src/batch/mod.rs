@@ -20,6 +20,7 @@ use glam::{Affine2, Affine3A};
 
 use crate::aabb::{Aabb2, Aabb3};
 use crate::block::{self, MapLanes};
+use crate::extended;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
 use crate::rigid2::Rigid2;
@@ -66,8 +67,10 @@ impl std::error::Error for BatchError {}
 pub(crate) trait BoxSource<const N: usize> {
     /// The number of boxes, or an error when the layout's columns disagree.
     fn len(&self) -> Result<usize, BatchError>;
-    /// Boxes `i..i + count` (count <= lanes) as lanes.
+    /// Boxes `i..i + count` (`count <= L::WIDTH`) as lanes; lanes past `count` are zero.
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
+    /// Box `i` as `(min, max)`, for the extended path.
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]);
 }
 
 /// Boxes to write, in some layout.
@@ -76,6 +79,8 @@ pub(crate) trait BoxSink<const N: usize> {
     fn len(&self) -> Result<usize, BatchError>;
     /// Writes lanes `0..count` to boxes `i..i + count`.
     fn store<L: LaneArray>(&mut self, i: usize, count: usize, min: Vector<L, N>, max: Vector<L, N>);
+    /// Writes box `i`.
+    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
 }
 
 /// Transforms to read: one per box, or one shared by all.
@@ -84,8 +89,10 @@ pub(crate) trait MapSource<const N: usize> {
     type Lanes<L: LaneArray>: MapLanes<L, N>;
     /// The number of transforms, `None` for one shared transform.
     fn len(&self) -> Option<usize>;
-    /// Transforms `i..i + count` as lanes.
+    /// Transforms `i..i + count` as lanes; lanes past `count` are zero.
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L>;
+    /// Transform `i` as columns (`cols[j][i] = m_ij`) and translation.
+    fn get(&self, i: usize) -> ([[f32; N]; N], [f32; N]);
 }
 
 /// The job every batch entry point runs: blocks of lanes through the kernel.
@@ -98,24 +105,59 @@ struct Run<B, X, O, const N: usize> {
     rounding: Rounding,
 }
 
-impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Job for Run<B, X, O, N> {
+impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Run<B, X, O, N> {
+    /// Every block with one kernel; `method` and `outward` are constants at each call site,
+    /// so that each loop is specialised to its kernel.
     #[inline(always)]
-    fn run<L: LaneArray>(mut self) {
+    fn blocks<L: LaneArray>(&mut self, method: Method, outward: bool) {
         let w = L::WIDTH;
         let mut i = 0;
         while i + w <= self.len {
-            let (lo, hi) = self.local.load::<L>(i, w);
-            let map = self.xf.load::<L>(i, w);
-            let (min, max) = block::transform(&map, lo, hi, self.method, self.rounding);
-            self.out.store(i, w, min, max);
+            self.block::<L>(i, w, method, outward);
             i += w;
         }
         if i < self.len {
-            let count = self.len - i;
-            let (lo, hi) = self.local.load::<L>(i, count);
-            let map = self.xf.load::<L>(i, count);
-            let (min, max) = block::transform(&map, lo, hi, self.method, self.rounding);
-            self.out.store(i, count, min, max);
+            self.block::<L>(i, self.len - i, method, outward);
+        }
+    }
+
+    #[inline(always)]
+    fn block<L: LaneArray>(&mut self, i: usize, count: usize, method: Method, outward: bool) {
+        let (lo, hi) = self.local.load::<L>(i, count);
+        let map = self.xf.load::<L>(i, count);
+        let (min, max, stands) = block::transform(&map, lo, hi, method, outward);
+        self.out.store(i, count, min, max);
+        // Lanes past `count` hold a zero box through a zero map: they stand.
+        if stands.any_nonzero() {
+            let redo: [bool; 32] = core::array::from_fn(|k| k < count && stands.get(k).is_nan());
+            self.redo(i, &redo);
+        }
+    }
+
+    /// Recomputes the boxes `i + k` marked in `redo` on the extended path.
+    #[cold]
+    #[inline(never)]
+    fn redo(&mut self, i: usize, redo: &[bool; 32]) {
+        for k in (0..32).filter(|&k| redo[k]) {
+            let (lo, hi) = self.local.get(i + k);
+            let (cols, t) = self.xf.get(i + k);
+            let (min, max) = extended::transform(cols, t, lo, hi, self.rounding);
+            self.out.set(i + k, min, max);
+        }
+    }
+}
+
+impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Job for Run<B, X, O, N> {
+    #[inline(always)]
+    fn run<L: LaneArray>(mut self) {
+        let outward = self.rounding == Rounding::Outward;
+        match (self.method, outward) {
+            (Method::Naive, false) => self.blocks::<L>(Method::Naive, false),
+            (Method::Naive, true) => self.blocks::<L>(Method::Naive, true),
+            (Method::AbsMatrix, false) => self.blocks::<L>(Method::AbsMatrix, false),
+            (Method::AbsMatrix, true) => self.blocks::<L>(Method::AbsMatrix, true),
+            (Method::SignSelect, false) => self.blocks::<L>(Method::SignSelect, false),
+            (Method::SignSelect, true) => self.blocks::<L>(Method::SignSelect, true),
         }
     }
 }
@@ -347,4 +389,103 @@ pub fn transform_slice(
     rounding: Rounding,
 ) -> Result<(), BatchError> {
     Batch::new(method, rounding).aos(local, xf, out)
+}
+
+#[cfg(test)]
+mod tests {
+    //! The 16-lane instantiation (the AVX-512 backend's lane type) run without AVX-512:
+    //! every lane does the same arithmetic at any width, so it must reproduce the 8-lane
+    //! backends exactly. This covers the 16-lane code paths (blocks spanning two AoSoA
+    //! blocks, tails, the extended path) on CPUs that cannot run the AVX-512 backend.
+
+    use super::*;
+    use crate::simd::F32s;
+    use glam::{Quat, Vec3, Vec3A};
+
+    fn run_lanes<L: LaneArray>(
+        method: Method,
+        rounding: Rounding,
+        local: &[Aabb3],
+        xf: &[Affine3A],
+        out: &mut [Aabb3],
+    ) {
+        let job: Run<_, _, _, 3> = Run {
+            local,
+            xf,
+            out,
+            len: local.len(),
+            method,
+            rounding,
+        };
+        job.run::<L>();
+    }
+
+    fn inputs(n: usize) -> (Vec<Aabb3>, Vec<Affine3A>) {
+        let specials = [f32::NAN, f32::INFINITY, -f32::INFINITY, 3e38, -0.0, 1e-45];
+        (0..n)
+            .map(|k| {
+                let x = k as f32;
+                let mut b = Aabb3::new(Vec3A::new(-x, 0.5 * x, -1.0), Vec3A::new(x + 1.0, x, 2.0));
+                let mut xf = Affine3A::from_scale_rotation_translation(
+                    Vec3::new(1.0 + x * 0.01, 2.0, 0.5),
+                    Quat::from_rotation_y(x),
+                    Vec3::splat(x * 10.0),
+                );
+                if k % 7 == 3 {
+                    b.min.y = specials[k % specials.len()];
+                }
+                if k % 11 == 5 {
+                    xf.matrix3.y_axis.z = specials[k % specials.len()];
+                }
+                (b, xf)
+            })
+            .unzip()
+    }
+
+    fn same(a: &[Aabb3], b: &[Aabb3]) -> bool {
+        let eq = |x: f32, y: f32| x == y || (x.is_nan() && y.is_nan());
+        a.iter()
+            .zip(b)
+            .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
+    }
+
+    #[test]
+    fn sixteen_lanes_reproduce_eight() {
+        for n in [0, 1, 15, 16, 17, 40, 333] {
+            let (local, xf) = inputs(n);
+            for method in Method::ALL {
+                for rounding in Rounding::ALL {
+                    let mut reference = vec![Aabb3::NAN; n];
+                    let mut sixteen = vec![Aabb3::NAN; n];
+                    run_lanes::<F32s<8, false>>(method, rounding, &local, &xf, &mut reference);
+                    run_lanes::<F32s<16, false>>(method, rounding, &local, &xf, &mut sixteen);
+                    assert!(same(&reference, &sixteen), "{method:?} {rounding:?} n={n}");
+                    // Fused: `f32::mul_add` is correctly rounded whether or not the
+                    // instruction exists, so both widths must agree here too.
+                    run_lanes::<F32s<8, true>>(method, rounding, &local, &xf, &mut reference);
+                    run_lanes::<F32s<16, true>>(method, rounding, &local, &xf, &mut sixteen);
+                    assert!(
+                        same(&reference, &sixteen),
+                        "{method:?} {rounding:?} n={n} fused"
+                    );
+                    // AoSoA blocks, where 16 lanes span two blocks.
+                    let (l8, x8) = (Aabb3x8::pack(&local), Affine3x8::pack(&xf));
+                    let mut o8 = vec![Aabb3x8::EMPTY; l8.len()];
+                    let job: Run<_, _, _, 3> = Run {
+                        local: &l8[..],
+                        xf: &x8[..],
+                        out: &mut o8[..],
+                        len: l8.len() * 8,
+                        method,
+                        rounding,
+                    };
+                    job.run::<F32s<16, true>>();
+                    assert!(
+                        same(&Aabb3x8::unpack(&o8, n), &reference),
+                        "{method:?} {rounding:?} n={n} aosoa"
+                    );
+                }
+            }
+        }
+    }
 }

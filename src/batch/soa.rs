@@ -4,9 +4,8 @@ use glam::Affine3A;
 
 use super::{BatchError, BoxSink, BoxSource, MapSource};
 use crate::aabb::Aabb3;
-use crate::block::gather;
 use crate::kernel::AffineLanes;
-use crate::lane::Vector;
+use crate::lane::{Lane, Vector};
 use crate::simd::LaneArray;
 
 /// Owned SoA boxes: `min[axis][box]`, `max[axis][box]` (`min[0]` is `min_x`, ...).
@@ -151,10 +150,29 @@ impl BoxSource<3> for AabbSoaRef<'_> {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
-        (
-            Vector(self.min.map(|c| gather(i, count, |b| c[b]))),
-            Vector(self.max.map(|c| gather(i, count, |b| c[b]))),
-        )
+        if count == L::WIDTH {
+            let column = |c: &[&[f32]; 3]| {
+                Vector([
+                    L::load(&c[0][i..]),
+                    L::load(&c[1][i..]),
+                    L::load(&c[2][i..]),
+                ])
+            };
+            return (column(&self.min), column(&self.max));
+        }
+        let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
+        for a in 0..3 {
+            for k in 0..L::WIDTH {
+                if k < count {
+                    lo.0[a].set(k, self.min[a][i + k]);
+                    hi.0[a].set(k, self.max[a][i + k]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+    fn get(&self, i: usize) -> ([f32; 3], [f32; 3]) {
+        (self.min.map(|c| c[i]), self.max.map(|c| c[i]))
     }
 }
 
@@ -173,15 +191,26 @@ impl BoxSink<3> for AabbSoaMut<'_> {
         min: Vector<L, 3>,
         max: Vector<L, 3>,
     ) {
-        for a in 0..3 {
-            for (k, (lo, hi)) in self.min[a][i..i + count]
-                .iter_mut()
-                .zip(&mut self.max[a][i..i + count])
-                .enumerate()
-            {
-                *lo = min.0[a].get(k);
-                *hi = max.0[a].get(k);
+        if count == L::WIDTH {
+            for a in 0..3 {
+                min.0[a].store(&mut self.min[a][i..]);
+                max.0[a].store(&mut self.max[a][i..]);
             }
+            return;
+        }
+        for a in 0..3 {
+            for k in 0..L::WIDTH {
+                if k < count {
+                    self.min[a][i + k] = min.0[a].get(k);
+                    self.max[a][i + k] = max.0[a].get(k);
+                }
+            }
+        }
+    }
+    fn set(&mut self, i: usize, min: [f32; 3], max: [f32; 3]) {
+        for a in 0..3 {
+            self.min[a][i] = min[a];
+            self.max[a][i] = max[a];
         }
     }
 }
@@ -201,11 +230,43 @@ impl MapSource<3> for Affine3SoaRef<'_> {
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        AffineLanes {
-            cols: self
-                .cols
-                .map(|col| Vector(col.map(|c| gather(i, count, |b| c[b])))),
-            t: Vector(self.translation.map(|c| gather(i, count, |b| c[b]))),
+        if count == L::WIDTH {
+            let column = |c: &[&[f32]; 3]| {
+                Vector([
+                    L::load(&c[0][i..]),
+                    L::load(&c[1][i..]),
+                    L::load(&c[2][i..]),
+                ])
+            };
+            return AffineLanes {
+                cols: [
+                    column(&self.cols[0]),
+                    column(&self.cols[1]),
+                    column(&self.cols[2]),
+                ],
+                t: column(&self.translation),
+            };
         }
+        let mut map = AffineLanes {
+            cols: [Vector::<L, 3>::splat(0.0); 3],
+            t: Vector::splat(0.0),
+        };
+        for a in 0..3 {
+            for k in 0..L::WIDTH {
+                if k < count {
+                    for j in 0..3 {
+                        map.cols[j].0[a].set(k, self.cols[j][a][i + k]);
+                    }
+                    map.t.0[a].set(k, self.translation[a][i + k]);
+                }
+            }
+        }
+        map
+    }
+    fn get(&self, i: usize) -> ([[f32; 3]; 3], [f32; 3]) {
+        (
+            self.cols.map(|c| c.map(|row| row[i])),
+            self.translation.map(|row| row[i]),
+        )
     }
 }

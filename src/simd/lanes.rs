@@ -13,22 +13,20 @@ use crate::lane::Lane;
 pub(crate) trait LaneArray: Lane {
     /// The number of lanes.
     const WIDTH: usize;
-    /// Lanes `f(0), f(1), ..., f(WIDTH - 1)`.
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self;
     /// Lane `k`.
     fn get(&self, k: usize) -> f32;
     /// Sets lane `k`.
     fn set(&mut self, k: usize, x: f32);
-    /// Bit `k` set where lane `k` of `self <= other` (clear where either is NaN).
-    fn le_bits(self, other: Self) -> u32;
+    /// Lanes from `src[..WIDTH]` (one vector load).
+    fn load(src: &[f32]) -> Self;
+    /// Writes the lanes to `dst[..WIDTH]` (one vector store).
+    fn store(self, dst: &mut [f32]);
+    /// True when any lane is not zero (NaN included).
+    fn any_nonzero(self) -> bool;
 }
 
 impl LaneArray for f32 {
     const WIDTH: usize = 1;
-    #[inline(always)]
-    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
-        f(0)
-    }
     #[inline(always)]
     fn get(&self, _: usize) -> f32 {
         *self
@@ -38,8 +36,16 @@ impl LaneArray for f32 {
         *self = x;
     }
     #[inline(always)]
-    fn le_bits(self, other: Self) -> u32 {
-        u32::from(self <= other)
+    fn load(src: &[f32]) -> Self {
+        src[0]
+    }
+    #[inline(always)]
+    fn store(self, dst: &mut [f32]) {
+        dst[0] = self;
+    }
+    #[inline(always)]
+    fn any_nonzero(self) -> bool {
+        self != 0.0
     }
 }
 
@@ -50,9 +56,23 @@ impl LaneArray for f32 {
 pub(crate) struct F32s<const W: usize, const FMA: bool>(pub [f32; W]);
 
 impl<const W: usize, const FMA: bool> F32s<W, FMA> {
+    // Plain indexed loops rather than `array::from_fn`/`map`: their closures and
+    // internal adapters are not always inlined into the hot loop, which stops LLVM
+    // from vectorising the kernel.
     #[inline(always)]
-    fn zip(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
-        F32s(core::array::from_fn(|k| f(self.0[k], o.0[k])))
+    fn zip(mut self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        for k in 0..W {
+            self.0[k] = f(self.0[k], o.0[k]);
+        }
+        self
+    }
+
+    #[inline(always)]
+    fn each(mut self, f: impl Fn(f32) -> f32) -> Self {
+        for k in 0..W {
+            self.0[k] = f(self.0[k]);
+        }
+        self
     }
 }
 
@@ -84,7 +104,7 @@ impl<const W: usize, const FMA: bool> Neg for F32s<W, FMA> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
-        F32s(self.0.map(|a| -a))
+        self.each(|a| -a)
     }
 }
 
@@ -104,34 +124,33 @@ impl<const W: usize, const FMA: bool> Lane for F32s<W, FMA> {
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        F32s(self.0.map(f32::abs))
+        self.each(f32::abs)
     }
     #[inline(always)]
     fn mul_add(self, b: Self, c: Self) -> Self {
         if FMA {
-            F32s(core::array::from_fn(|k| self.0[k].mul_add(b.0[k], c.0[k])))
+            let mut r = c;
+            for k in 0..W {
+                r.0[k] = self.0[k].mul_add(b.0[k], c.0[k]);
+            }
+            r
         } else {
             self * b + c
         }
     }
     #[inline(always)]
-    fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
-        F32s(core::array::from_fn(|k| {
+    fn select_nonneg(self, if_nonneg: Self, mut otherwise: Self) -> Self {
+        for k in 0..W {
             if self.0[k] >= 0.0 {
-                if_nonneg.0[k]
-            } else {
-                otherwise.0[k]
+                otherwise.0[k] = if_nonneg.0[k];
             }
-        }))
+        }
+        otherwise
     }
 }
 
 impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
     const WIDTH: usize = W;
-    #[inline(always)]
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
-        F32s(core::array::from_fn(f))
-    }
     #[inline(always)]
     fn get(&self, k: usize) -> f32 {
         self.0[k]
@@ -141,8 +160,23 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
         self.0[k] = x;
     }
     #[inline(always)]
-    fn le_bits(self, other: Self) -> u32 {
-        (0..W).fold(0, |bits, k| bits | u32::from(self.0[k] <= other.0[k]) << k)
+    fn load(src: &[f32]) -> Self {
+        let mut r = [0.0; W];
+        r.copy_from_slice(&src[..W]);
+        F32s(r)
+    }
+    #[inline(always)]
+    fn store(self, dst: &mut [f32]) {
+        dst[..W].copy_from_slice(&self.0);
+    }
+    #[inline(always)]
+    fn any_nonzero(self) -> bool {
+        // A non-short-circuiting OR over the lanes: one compare and one mask test.
+        let mut any = false;
+        for k in 0..W {
+            any |= self.0[k] != 0.0;
+        }
+        any
     }
 }
 
@@ -177,10 +211,6 @@ impl Lane for wide::f32x8 {
 impl LaneArray for wide::f32x8 {
     const WIDTH: usize = 8;
     #[inline(always)]
-    fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
-        wide::f32x8::new(core::array::from_fn(f))
-    }
-    #[inline(always)]
     fn get(&self, k: usize) -> f32 {
         self.as_array()[k]
     }
@@ -189,7 +219,17 @@ impl LaneArray for wide::f32x8 {
         self.as_mut_array()[k] = x;
     }
     #[inline(always)]
-    fn le_bits(self, other: Self) -> u32 {
-        self.simd_le(other).to_bitmask()
+    fn load(src: &[f32]) -> Self {
+        let mut r = [0.0; 8];
+        r.copy_from_slice(&src[..8]);
+        wide::f32x8::new(r)
+    }
+    #[inline(always)]
+    fn store(self, dst: &mut [f32]) {
+        dst[..8].copy_from_slice(self.as_array());
+    }
+    #[inline(always)]
+    fn any_nonzero(self) -> bool {
+        self.simd_ne(wide::f32x8::ZERO).any()
     }
 }

@@ -1,0 +1,147 @@
+//! Inputs, peers and memory rooflines shared by the benches and the trade report.
+#![allow(dead_code)]
+
+use bvkit::{Aabb3, Aabb3x8, Affine3x8};
+use glam::{Affine3A, Quat, Vec3, Vec3A};
+
+/// A small deterministic generator (xorshift64*), so inputs need no RNG crate.
+pub struct Xorshift(pub u64);
+
+impl Xorshift {
+    pub fn next_f32(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let bits = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40;
+        bits as f32 / (1u64 << 24) as f32
+    }
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.next_f32()
+    }
+}
+
+/// `n` local boxes and rigid poses (rotation + translation) of a typical scene.
+pub fn scene(n: usize, seed: u64) -> (Vec<Aabb3>, Vec<Affine3A>, Vec<(Quat, Vec3)>) {
+    let mut r = Xorshift(seed | 1);
+    let mut boxes = Vec::with_capacity(n);
+    let mut xfs = Vec::with_capacity(n);
+    let mut poses = Vec::with_capacity(n);
+    for _ in 0..n {
+        let c = Vec3A::new(r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0));
+        let e = Vec3A::new(r.range(0.1, 2.0), r.range(0.1, 2.0), r.range(0.1, 2.0));
+        boxes.push(Aabb3::from_center_half_extents(c, e));
+        let axis = Vec3::new(
+            r.range(-1.0, 1.0),
+            r.range(-1.0, 1.0),
+            r.range(-1.0, 1.0) + 2.0,
+        )
+        .normalize();
+        let q = Quat::from_axis_angle(axis, r.range(-3.0, 3.0));
+        let t = Vec3::new(
+            r.range(-500.0, 500.0),
+            r.range(-500.0, 500.0),
+            r.range(-500.0, 500.0),
+        );
+        xfs.push(Affine3A::from_rotation_translation(q, t));
+        poses.push((q, t));
+    }
+    (boxes, xfs, poses)
+}
+
+/// The glam 8-corner loop a user would write.
+pub fn glam_corners(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
+    for ((b, xf), o) in boxes.iter().zip(xfs).zip(out) {
+        let mut min = Vec3A::INFINITY;
+        let mut max = Vec3A::NEG_INFINITY;
+        for c in b.corners() {
+            let p = xf.transform_point3a(c);
+            min = min.min(p);
+            max = max.max(p);
+        }
+        *o = Aabb3::new(min, max);
+    }
+}
+
+/// The glam abs-matrix loop a user would write.
+pub fn glam_abs_matrix(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
+    for ((b, xf), o) in boxes.iter().zip(xfs).zip(out) {
+        let c = xf.transform_point3a((b.min + b.max) * 0.5);
+        let e = (b.max - b.min) * 0.5;
+        let m = xf.matrix3;
+        let we = m.x_axis.abs() * e.x + m.y_axis.abs() * e.y + m.z_axis.abs() * e.z;
+        *o = Aabb3::new(c - we, c + we);
+    }
+}
+
+/// parry3d's `Aabb::transform_by` over rigid poses.
+pub fn parry_transform_by(
+    boxes: &[parry3d::bounding_volume::Aabb],
+    poses: &[parry3d::math::Pose],
+    out: &mut [parry3d::bounding_volume::Aabb],
+) {
+    for ((b, p), o) in boxes.iter().zip(poses).zip(out) {
+        *o = b.transform_by(p);
+    }
+}
+
+/// The parry3d form of a scene.
+pub fn parry_scene(
+    boxes: &[Aabb3],
+    poses: &[(Quat, Vec3)],
+) -> (
+    Vec<parry3d::bounding_volume::Aabb>,
+    Vec<parry3d::math::Pose>,
+) {
+    (
+        boxes
+            .iter()
+            .map(|b| parry3d::bounding_volume::Aabb::new(b.min.into(), b.max.into()))
+            .collect(),
+        poses
+            .iter()
+            .map(|&(q, t)| parry3d::math::Pose::from_parts(t, q))
+            .collect(),
+    )
+}
+
+/// Memory roofline for AoSoA: reads every byte of the boxes and transforms and writes every
+/// byte of the output, in the same layout, with one addition per input float.
+pub fn roofline_aosoa(boxes: &[Aabb3x8], xfs: &[Affine3x8], out: &mut [Aabb3x8]) {
+    for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
+        for a in 0..3 {
+            for k in 0..8 {
+                let m = x.cols[0][a][k] + x.cols[1][a][k] + x.cols[2][a][k] + x.translation[a][k];
+                o.min[a][k] = b.min[a][k] + m;
+                o.max[a][k] = b.max[a][k] + m;
+            }
+        }
+    }
+}
+
+/// Memory roofline for SoA columns (6 box columns, 12 transform columns, 6 outputs).
+pub fn roofline_soa(boxes: &bvkit::AabbSoa, xfs: &bvkit::Affine3Soa, out: &mut bvkit::AabbSoa) {
+    for a in 0..3 {
+        let (c0, c1, c2, t) = (
+            &xfs.cols[0][a],
+            &xfs.cols[1][a],
+            &xfs.cols[2][a],
+            &xfs.translation[a],
+        );
+        let (lo, hi) = (&boxes.min[a], &boxes.max[a]);
+        let [omin, omax] = [&mut out.min[a], &mut out.max[a]];
+        for k in 0..lo.len() {
+            let m = c0[k] + c1[k] + c2[k] + t[k];
+            omin[k] = lo[k] + m;
+            omax[k] = hi[k] + m;
+        }
+    }
+}
+
+/// Memory roofline for AoS slices.
+pub fn roofline_aos(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
+    for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
+        let m = x.matrix3.x_axis + x.matrix3.y_axis + x.matrix3.z_axis + x.translation;
+        *o = Aabb3::new(b.min + m, b.max + m);
+    }
+}
