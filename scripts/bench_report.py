@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Tabulates one `cargo bench --bench batch` run (criterion's JSON under target/criterion).
+
+Prints, per batch size, ns per box (criterion's median) for every kernel, layout and
+backend, the peers and the memory rooflines, and the ratios the batch issue asks for:
+speed-up over the parry3d loop, Outward over Nearest, and time over the roofline of the
+same layout. Usage: python3 scripts/bench_report.py [target/criterion]
+"""
+import json
+import pathlib
+import sys
+
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/criterion")
+rows = {}  # (size, name) -> ns per box
+for bench in root.glob("**/new/benchmark.json"):
+    meta = json.loads(bench.read_text())
+    group = meta["group_id"]
+    if not group.startswith("batch/"):
+        continue
+    size = group.split("/", 1)[1]
+    name = meta["function_id"] + ("/" + meta["value_str"] if meta.get("value_str") else "")
+    elements = meta["throughput"]["Elements"]
+    estimates = json.loads((bench.parent / "estimates.json").read_text())
+    rows[(size, name)] = estimates["median"]["point_estimate"] / elements
+
+sizes = [s for s in ["1K", "64K", "4M"] if any(k[0] == s for k in rows)]
+names = sorted({k[1] for k in rows}, key=lambda n: (not n.startswith("peer"), not n.startswith("roofline"), n))
+
+
+def get(size, name):
+    return rows.get((size, name))
+
+
+print("| kernel | " + " | ".join(f"{s} ns/box" for s in sizes) + " |")
+print("|---|" + "---:|" * len(sizes))
+for n in names:
+    cells = [f"{get(s, n):.3f}" if get(s, n) is not None else "" for s in sizes]
+    print(f"| {n} | " + " | ".join(cells) + " |")
+
+print()
+print("| ratio | " + " | ".join(sizes) + " |")
+print("|---|" + "---:|" * len(sizes))
+backends = ["avx512", "avx2", "baseline", "wide", "scalar"]
+best = next((b for b in backends if any(k[1] == f"aosoa/{b}/abs-matrix/nearest" for k in rows)), None)
+
+
+def ratio(label, num, den):
+    cells = []
+    for s in sizes:
+        a, b = get(s, num), get(s, den)
+        cells.append(f"{a / b:.2f}" if a and b else "")
+    print(f"| {label} | " + " | ".join(cells) + " |")
+
+
+if best:
+    k = f"aosoa/{best}"
+    ratio(f"parry3d loop / {k} abs-matrix nearest (speed-up)", "peer/parry3d-transform_by", f"{k}/abs-matrix/nearest")
+    ratio(f"glam abs-matrix loop / {k} abs-matrix nearest (speed-up)", "peer/glam-abs-matrix", f"{k}/abs-matrix/nearest")
+    for m in ["abs-matrix", "sign-select"]:
+        ratio(f"{k} {m}: outward / nearest", f"{k}/{m}/outward", f"{k}/{m}/nearest")
+    for layout in ["aosoa", "soa", "aos"]:
+        for m in ["abs-matrix/nearest", "abs-matrix/outward", "sign-select/nearest"]:
+            ratio(f"{layout}/{best} {m} / roofline/{layout}", f"{layout}/{best}/{m}", f"roofline/{layout}")
+    ratio(f"{k} abs-matrix nearest: wide / {best}", f"aosoa/wide/abs-matrix/nearest", f"{k}/abs-matrix/nearest")
+    ratio(f"{k} abs-matrix nearest: baseline / {best}", f"aosoa/baseline/abs-matrix/nearest", f"{k}/abs-matrix/nearest")
