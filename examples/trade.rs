@@ -14,10 +14,10 @@
 //! as CSV and an SVG plot to the paths it prints. Timings vary run to run; the accuracy
 //! columns are identical for the fixed seed.
 
-#[path = "../benches/common/mod.rs"]
-mod common;
 #[path = "../tests/cases/mod.rs"]
 mod cases;
+#[path = "../benches/common/mod.rs"]
+mod common;
 #[path = "../tests/oracle/mod.rs"]
 mod oracle;
 
@@ -81,8 +81,14 @@ struct Accuracy {
 
 fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
     match rounding {
-        Rounding::Nearest => Bound::Nearest { gamma_n: method.nearest_gamma(dims), tiny: f64::from(TINY_ERROR) },
-        Rounding::Outward => Bound::Outward { k: method.outward_pad(dims), tiny: f64::from(TINY_PAD) },
+        Rounding::Nearest => Bound::Nearest {
+            gamma_n: method.nearest_gamma(dims),
+            tiny: f64::from(TINY_ERROR),
+        },
+        Rounding::Outward => Bound::Outward {
+            k: method.outward_pad(dims),
+            tiny: f64::from(TINY_PAD),
+        },
     }
 }
 
@@ -102,11 +108,16 @@ fn ns_per_box(n: usize, reps: usize, mut run: impl FnMut()) -> f64 {
 
 /// Times `run(n)` at the in-cache and the DRAM size.
 fn times(mut run: impl FnMut(usize)) -> (f64, f64) {
-    (ns_per_box(CACHE, 301, || run(CACHE)), ns_per_box(DRAM, 5, || run(DRAM)))
+    (
+        ns_per_box(CACHE, 301, || run(CACHE)),
+        ns_per_box(DRAM, 5, || run(DRAM)),
+    )
 }
 
 /// The seeded oracle sample.
-fn sample<const N: usize>(make: impl Fn(Class, &mut rand::rngs::StdRng) -> Problem<N>) -> Vec<(Class, Problem<N>)> {
+fn sample<const N: usize>(
+    make: impl Fn(Class, &mut rand::rngs::StdRng) -> Problem<N>,
+) -> Vec<(Class, Problem<N>)> {
     let mut out = Vec::new();
     for class in ACCURACY_CLASSES {
         let r = &mut rng(SEED ^ (class as u64) << 40);
@@ -117,10 +128,16 @@ fn sample<const N: usize>(make: impl Fn(Class, &mut rand::rngs::StdRng) -> Probl
 
 /// Checks `results` against the oracle (panics on a broken contract: the report must not
 /// print figures of a kernel that is wrong) and summarises.
-fn accuracy<const N: usize>(sample: &[(Class, Problem<N>)], results: &[([f32; N], [f32; N])], bound: Bound) -> Accuracy {
-    let (mut worst, mut contained, mut overhead_sum, mut overhead_count) = (0.0f64, 0usize, 0.0, 0usize);
+fn accuracy<const N: usize>(
+    sample: &[(Class, Problem<N>)],
+    results: &[([f32; N], [f32; N])],
+    bound: Bound,
+) -> Accuracy {
+    let (mut worst, mut contained, mut overhead_sum, mut overhead_count) =
+        (0.0f64, 0usize, 0.0, 0usize);
     for ((class, p), (min, max)) in sample.iter().zip(results) {
-        let m = check(p, *min, *max, bound).unwrap_or_else(|e| panic!("contract broken: {e}\n{p:?}"));
+        let m =
+            check(p, *min, *max, bound).unwrap_or_else(|e| panic!("contract broken: {e}\n{p:?}"));
         worst = worst.max(m.worst_error_us);
         contained += usize::from(m.contains);
         if let (Class::Typical, Some(o)) = (class, m.overhead) {
@@ -137,18 +154,30 @@ fn accuracy<const N: usize>(sample: &[(Class, Problem<N>)], results: &[([f32; N]
 
 fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
     let [x, y, z] = p.cols.map(Vec3A::from_array);
-    let xf = Affine3A { matrix3: Mat3A::from_cols(x, y, z), translation: Vec3A::from_array(p.t) };
-    (Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)), xf)
+    let xf = Affine3A {
+        matrix3: Mat3A::from_cols(x, y, z),
+        translation: Vec3A::from_array(p.t),
+    };
+    (
+        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
+        xf,
+    )
 }
 
 fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
     let [x, y] = p.cols.map(Vec2::from_array);
     let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
-    (Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)), xf)
+    (
+        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
+        xf,
+    )
 }
 
 fn rigid2(p: &Problem<2>) -> (Aabb2, Rigid2) {
-    (affine2(p).0, Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)))
+    (
+        affine2(p).0,
+        Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)),
+    )
 }
 
 fn flat3(b: &Aabb3) -> ([f32; 3], [f32; 3]) {
@@ -174,7 +203,13 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
     let mut os = AabbSoa::empty(DRAM);
     let sample = sample::<3>(problem);
     let (sb, sx): (Vec<Aabb3>, Vec<Affine3A>) = sample.iter().map(|(_, p)| affine3(p)).unzip();
-    let row = |kernel: String, method, rounding, layout, backend: &'static str, (ns_cache, ns_dram), accuracy| Row {
+    let row = |kernel: String,
+               method,
+               rounding,
+               layout,
+               backend: &'static str,
+               (ns_cache, ns_dram),
+               accuracy| Row {
         class: "3D affine",
         kernel,
         method,
@@ -190,22 +225,76 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
     progress("3D peers and rooflines");
     let (pb, pp) = common::parry_scene(&boxes, &poses);
     let mut op = pb.clone();
-    let t = times(|n| common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n]));
-    rows.push(row("parry3d Aabb::transform_by (rigid)".into(), None, None, "aos", "peer", t, None));
+    let t = times(|n| {
+        common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
+    });
+    rows.push(row(
+        "parry3d Aabb::transform_by (rigid)".into(),
+        None,
+        None,
+        "aos",
+        "peer",
+        t,
+        None,
+    ));
     let peer_accuracy = |f: fn(&[Aabb3], &[Affine3A], &mut [Aabb3])| {
         let mut o = vec![Aabb3::EMPTY; sb.len()];
         f(&sb, &sx, &mut o);
         let results: Vec<_> = o.iter().map(flat3).collect();
-        Some(accuracy(&sample, &results, Bound::Nearest { gamma_n: 1 << 20, tiny: 1e30 }))
+        Some(accuracy(
+            &sample,
+            &results,
+            Bound::Nearest {
+                gamma_n: 1 << 20,
+                tiny: 1e30,
+            },
+        ))
     };
-    let t = times(|n| common::glam_corners(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n]));
-    rows.push(row("glam 8-corner loop".into(), None, None, "aos", "peer", t, peer_accuracy(common::glam_corners)));
-    let t = times(|n| common::glam_abs_matrix(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n]));
-    rows.push(row("glam abs-matrix loop".into(), None, None, "aos", "peer", t, peer_accuracy(common::glam_abs_matrix)));
-    let t = times(|n| common::roofline_aosoa(black_box(&b8[..n / 8]), black_box(&x8[..n / 8]), &mut o8[..n / 8]));
-    rows.push(row("memory roofline".into(), None, None, "aosoa", "roofline", t, None));
+    let t = times(|n| {
+        common::glam_corners(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+    });
+    rows.push(row(
+        "glam 8-corner loop".into(),
+        None,
+        None,
+        "aos",
+        "peer",
+        t,
+        peer_accuracy(common::glam_corners),
+    ));
+    let t = times(|n| {
+        common::glam_abs_matrix(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+    });
+    rows.push(row(
+        "glam abs-matrix loop".into(),
+        None,
+        None,
+        "aos",
+        "peer",
+        t,
+        peer_accuracy(common::glam_abs_matrix),
+    ));
+    let t = times(|n| {
+        common::roofline_aosoa(
+            black_box(&b8[..n / 8]),
+            black_box(&x8[..n / 8]),
+            &mut o8[..n / 8],
+        )
+    });
+    rows.push(row(
+        "memory roofline".into(),
+        None,
+        None,
+        "aosoa",
+        "roofline",
+        t,
+        None,
+    ));
     let small = |n: usize| {
-        let b = AabbSoa { min: bs.min.clone().map(|c| c[..n].to_vec()), max: bs.max.clone().map(|c| c[..n].to_vec()) };
+        let b = AabbSoa {
+            min: bs.min.clone().map(|c| c[..n].to_vec()),
+            max: bs.max.clone().map(|c| c[..n].to_vec()),
+        };
         let x = Affine3Soa {
             cols: xs.cols.clone().map(|c| c.map(|v| v[..n].to_vec())),
             translation: xs.translation.clone().map(|c| c[..n].to_vec()),
@@ -214,12 +303,34 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
     };
     let (cb, cx, mut co) = small(CACHE);
     let t = (
-        ns_per_box(CACHE, 301, || common::roofline_soa(black_box(&cb), black_box(&cx), &mut co)),
-        ns_per_box(DRAM, 5, || common::roofline_soa(black_box(&bs), black_box(&xs), &mut os)),
+        ns_per_box(CACHE, 301, || {
+            common::roofline_soa(black_box(&cb), black_box(&cx), &mut co)
+        }),
+        ns_per_box(DRAM, 5, || {
+            common::roofline_soa(black_box(&bs), black_box(&xs), &mut os)
+        }),
     );
-    rows.push(row("memory roofline".into(), None, None, "soa", "roofline", t, None));
-    let t = times(|n| common::roofline_aos(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n]));
-    rows.push(row("memory roofline".into(), None, None, "aos", "roofline", t, None));
+    rows.push(row(
+        "memory roofline".into(),
+        None,
+        None,
+        "soa",
+        "roofline",
+        t,
+        None,
+    ));
+    let t = times(|n| {
+        common::roofline_aos(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+    });
+    rows.push(row(
+        "memory roofline".into(),
+        None,
+        None,
+        "aos",
+        "roofline",
+        t,
+        None,
+    ));
 
     for method in Method::ALL {
         for rounding in Rounding::ALL {
@@ -227,46 +338,122 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
             let b3 = bound(method, rounding, 3);
             progress(&format!("3D {kernel}"));
             let t = times(|n| {
-                for ((b, xf), o) in black_box(&boxes[..n]).iter().zip(&xfs[..n]).zip(&mut out[..n]) {
+                for ((b, xf), o) in black_box(&boxes[..n])
+                    .iter()
+                    .zip(&xfs[..n])
+                    .zip(&mut out[..n])
+                {
                     *o = b.transformed(xf, method, rounding);
                 }
             });
-            let results: Vec<_> = sb.iter().zip(&sx).map(|(b, x)| flat3(&b.transformed(x, method, rounding))).collect();
-            rows.push(row(kernel.clone(), Some(method), Some(rounding), "single", "glam simd", t, Some(accuracy(&sample, &results, b3))));
+            let results: Vec<_> = sb
+                .iter()
+                .zip(&sx)
+                .map(|(b, x)| flat3(&b.transformed(x, method, rounding)))
+                .collect();
+            rows.push(row(
+                kernel.clone(),
+                Some(method),
+                Some(rounding),
+                "single",
+                "glam simd",
+                t,
+                Some(accuracy(&sample, &results, b3)),
+            ));
             let t = times(|n| {
-                for ((b, xf), o) in black_box(&boxes[..n]).iter().zip(&xfs[..n]).zip(&mut out[..n]) {
+                for ((b, xf), o) in black_box(&boxes[..n])
+                    .iter()
+                    .zip(&xfs[..n])
+                    .zip(&mut out[..n])
+                {
                     *o = b.transformed_scalar(xf, method, rounding);
                 }
             });
-            let results: Vec<_> = sb.iter().zip(&sx).map(|(b, x)| flat3(&b.transformed_scalar(x, method, rounding))).collect();
-            rows.push(row(kernel.clone(), Some(method), Some(rounding), "single", "scalar", t, Some(accuracy(&sample, &results, b3))));
+            let results: Vec<_> = sb
+                .iter()
+                .zip(&sx)
+                .map(|(b, x)| flat3(&b.transformed_scalar(x, method, rounding)))
+                .collect();
+            rows.push(row(
+                kernel.clone(),
+                Some(method),
+                Some(rounding),
+                "single",
+                "scalar",
+                t,
+                Some(accuracy(&sample, &results, b3)),
+            ));
 
             for &backend in backends {
                 let batch = Batch::new(method, rounding).on(backend).expect("supported");
                 let name = backend.name();
                 let mut o = vec![Aabb3::EMPTY; sb.len()];
-                let t = times(|n| batch.aos(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n]).unwrap());
+                let t = times(|n| {
+                    batch
+                        .aos(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+                        .unwrap()
+                });
                 batch.aos(&sb, &sx, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat3).collect();
-                rows.push(row(kernel.clone(), Some(method), Some(rounding), "aos", name, t, Some(accuracy(&sample, &results, b3))));
+                rows.push(row(
+                    kernel.clone(),
+                    Some(method),
+                    Some(rounding),
+                    "aos",
+                    name,
+                    t,
+                    Some(accuracy(&sample, &results, b3)),
+                ));
 
                 let (cb, cx, mut co) = small(CACHE);
                 let t = (
-                    ns_per_box(CACHE, 301, || batch.soa(black_box(cb.view()), cx.view(), co.view_mut()).unwrap()),
-                    ns_per_box(DRAM, 5, || batch.soa(black_box(bs.view()), xs.view(), os.view_mut()).unwrap()),
+                    ns_per_box(CACHE, 301, || {
+                        batch
+                            .soa(black_box(cb.view()), cx.view(), co.view_mut())
+                            .unwrap()
+                    }),
+                    ns_per_box(DRAM, 5, || {
+                        batch
+                            .soa(black_box(bs.view()), xs.view(), os.view_mut())
+                            .unwrap()
+                    }),
                 );
                 let (ssb, ssx) = (AabbSoa::from_boxes(&sb), Affine3Soa::from_affines(&sx));
                 let mut sso = AabbSoa::empty(sb.len());
                 batch.soa(ssb.view(), ssx.view(), sso.view_mut()).unwrap();
                 let results: Vec<_> = (0..sb.len()).map(|k| flat3(&sso.get(k))).collect();
-                rows.push(row(kernel.clone(), Some(method), Some(rounding), "soa", name, t, Some(accuracy(&sample, &results, b3))));
+                rows.push(row(
+                    kernel.clone(),
+                    Some(method),
+                    Some(rounding),
+                    "soa",
+                    name,
+                    t,
+                    Some(accuracy(&sample, &results, b3)),
+                ));
 
-                let t = times(|n| batch.aosoa(black_box(&b8[..n / 8]), black_box(&x8[..n / 8]), &mut o8[..n / 8]).unwrap());
+                let t = times(|n| {
+                    batch
+                        .aosoa(
+                            black_box(&b8[..n / 8]),
+                            black_box(&x8[..n / 8]),
+                            &mut o8[..n / 8],
+                        )
+                        .unwrap()
+                });
                 let (s8, x8s) = (Aabb3x8::pack(&sb), Affine3x8::pack(&sx));
                 let mut so8 = vec![Aabb3x8::EMPTY; s8.len()];
                 batch.aosoa(&s8, &x8s, &mut so8).unwrap();
                 let results: Vec<_> = Aabb3x8::unpack(&so8, sb.len()).iter().map(flat3).collect();
-                rows.push(row(kernel.clone(), Some(method), Some(rounding), "aosoa", name, t, Some(accuracy(&sample, &results, b3))));
+                rows.push(row(
+                    kernel.clone(),
+                    Some(method),
+                    Some(rounding),
+                    "aosoa",
+                    name,
+                    t,
+                    Some(accuracy(&sample, &results, b3)),
+                ));
             }
         }
     }
@@ -277,15 +464,29 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
 fn measure_2d(backends: &[Backend]) -> Vec<Row> {
     let mut rows = Vec::new();
     let (boxes3, _, poses) = common::scene(DRAM, 0x2d);
-    let boxes: Vec<Aabb2> = boxes3.iter().map(|b| Aabb2::new(b.min.truncate(), b.max.truncate())).collect();
-    let rigid: Vec<Rigid2> = poses.iter().map(|(q, t)| Rigid2::from_angle_translation(q.to_axis_angle().1, Vec2::new(t.x, t.y))).collect();
+    let boxes: Vec<Aabb2> = boxes3
+        .iter()
+        .map(|b| Aabb2::new(b.min.truncate(), b.max.truncate()))
+        .collect();
+    let rigid: Vec<Rigid2> = poses
+        .iter()
+        .map(|(q, t)| Rigid2::from_angle_translation(q.to_axis_angle().1, Vec2::new(t.x, t.y)))
+        .collect();
     let affine: Vec<Affine2> = rigid.iter().map(Rigid2::to_affine2).collect();
     let mut out = vec![Aabb2::EMPTY; DRAM];
     let affine_sample = sample::<2>(problem);
     let rigid_sample = sample::<2>(rigid_problem);
-    let (ab, ax): (Vec<Aabb2>, Vec<Affine2>) = affine_sample.iter().map(|(_, p)| affine2(p)).unzip();
+    let (ab, ax): (Vec<Aabb2>, Vec<Affine2>) =
+        affine_sample.iter().map(|(_, p)| affine2(p)).unzip();
     let (rb, rx): (Vec<Aabb2>, Vec<Rigid2>) = rigid_sample.iter().map(|(_, p)| rigid2(p)).unzip();
-    let row = |class, kernel: String, method, rounding, layout, backend, (ns_cache, ns_dram), accuracy| Row {
+    let row = |class,
+               kernel: String,
+               method,
+               rounding,
+               layout,
+               backend,
+               (ns_cache, ns_dram),
+               accuracy| Row {
         class,
         kernel,
         method: Some(method),
@@ -303,30 +504,98 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
             let b2 = bound(method, rounding, 2);
             progress(&format!("2D {kernel}"));
             let t = times(|n| {
-                for ((b, xf), o) in black_box(&boxes[..n]).iter().zip(&rigid[..n]).zip(&mut out[..n]) {
+                for ((b, xf), o) in black_box(&boxes[..n])
+                    .iter()
+                    .zip(&rigid[..n])
+                    .zip(&mut out[..n])
+                {
                     *o = b.transformed_rigid(xf, method, rounding);
                 }
             });
-            let results: Vec<_> = rb.iter().zip(&rx).map(|(b, x)| flat2(&b.transformed_rigid(x, method, rounding))).collect();
-            rows.push(row("2D rigid", kernel.clone(), method, rounding, "single", "scalar", t, accuracy(&rigid_sample, &results, b2)));
+            let results: Vec<_> = rb
+                .iter()
+                .zip(&rx)
+                .map(|(b, x)| flat2(&b.transformed_rigid(x, method, rounding)))
+                .collect();
+            rows.push(row(
+                "2D rigid",
+                kernel.clone(),
+                method,
+                rounding,
+                "single",
+                "scalar",
+                t,
+                accuracy(&rigid_sample, &results, b2),
+            ));
             let t = times(|n| {
-                for ((b, xf), o) in black_box(&boxes[..n]).iter().zip(&affine[..n]).zip(&mut out[..n]) {
+                for ((b, xf), o) in black_box(&boxes[..n])
+                    .iter()
+                    .zip(&affine[..n])
+                    .zip(&mut out[..n])
+                {
                     *o = b.transformed(xf, method, rounding);
                 }
             });
-            let results: Vec<_> = ab.iter().zip(&ax).map(|(b, x)| flat2(&b.transformed(x, method, rounding))).collect();
-            rows.push(row("2D affine", kernel.clone(), method, rounding, "single", "scalar", t, accuracy(&affine_sample, &results, b2)));
+            let results: Vec<_> = ab
+                .iter()
+                .zip(&ax)
+                .map(|(b, x)| flat2(&b.transformed(x, method, rounding)))
+                .collect();
+            rows.push(row(
+                "2D affine",
+                kernel.clone(),
+                method,
+                rounding,
+                "single",
+                "scalar",
+                t,
+                accuracy(&affine_sample, &results, b2),
+            ));
             for &backend in backends {
                 let batch = Batch::new(method, rounding).on(backend).expect("supported");
-                let t = times(|n| batch.aos_rigid2(black_box(&boxes[..n]), black_box(&rigid[..n]), &mut out[..n]).unwrap());
+                let t = times(|n| {
+                    batch
+                        .aos_rigid2(
+                            black_box(&boxes[..n]),
+                            black_box(&rigid[..n]),
+                            &mut out[..n],
+                        )
+                        .unwrap()
+                });
                 let mut o = vec![Aabb2::EMPTY; rb.len()];
                 batch.aos_rigid2(&rb, &rx, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat2).collect();
-                rows.push(row("2D rigid", kernel.clone(), method, rounding, "aos", backend.name(), t, accuracy(&rigid_sample, &results, b2)));
-                let t = times(|n| batch.aos2(black_box(&boxes[..n]), black_box(&affine[..n]), &mut out[..n]).unwrap());
+                rows.push(row(
+                    "2D rigid",
+                    kernel.clone(),
+                    method,
+                    rounding,
+                    "aos",
+                    backend.name(),
+                    t,
+                    accuracy(&rigid_sample, &results, b2),
+                ));
+                let t = times(|n| {
+                    batch
+                        .aos2(
+                            black_box(&boxes[..n]),
+                            black_box(&affine[..n]),
+                            &mut out[..n],
+                        )
+                        .unwrap()
+                });
                 batch.aos2(&ab, &ax, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat2).collect();
-                rows.push(row("2D affine", kernel.clone(), method, rounding, "aos", backend.name(), t, accuracy(&affine_sample, &results, b2)));
+                rows.push(row(
+                    "2D affine",
+                    kernel.clone(),
+                    method,
+                    rounding,
+                    "aos",
+                    backend.name(),
+                    t,
+                    accuracy(&affine_sample, &results, b2),
+                ));
             }
         }
     }
@@ -341,7 +610,9 @@ fn set_ratios(rows: &mut [Row]) {
             .filter(|r| r.class == class && r.method.is_some())
             .map(|r| r.ns_cache)
             .fold(f64::INFINITY, f64::min);
-        rows.iter_mut().filter(|r| r.class == class).for_each(|r| r.ratio = r.ns_cache / fastest);
+        rows.iter_mut()
+            .filter(|r| r.class == class)
+            .for_each(|r| r.ratio = r.ns_cache / fastest);
     }
 }
 
@@ -355,14 +626,31 @@ fn table(rows: &[Row]) -> String {
     s.push_str("|---|---|---|---|---:|---:|---:|---:|---:|---:|\n");
     for r in rows {
         let (worst, contains, overhead) = match r.accuracy {
-            Some(a) => (format!("{:.2}", a.worst_error_us), pct(a.contains), format!("{:.2e}", a.overhead)),
+            Some(a) => (
+                format!("{:.2}", a.worst_error_us),
+                pct(a.contains),
+                format!("{:.2e}", a.overhead),
+            ),
             None => ("".into(), "".into(), "".into()),
         };
-        let worst = if r.backend == "peer" && !worst.is_empty() { format!("{worst} (unbounded)") } else { worst };
+        let worst = if r.backend == "peer" && !worst.is_empty() {
+            format!("{worst} (unbounded)")
+        } else {
+            worst
+        };
         writeln!(
             s,
             "| {} | {} | {} | {} | {:.2} | {:.2} | {} | {} | {} | {:.2} |",
-            r.class, r.kernel, r.layout, r.backend, r.ns_cache, r.ns_dram, worst, contains, overhead, r.ratio
+            r.class,
+            r.kernel,
+            r.layout,
+            r.backend,
+            r.ns_cache,
+            r.ns_dram,
+            worst,
+            contains,
+            overhead,
+            r.ratio
         )
         .unwrap();
     }
@@ -374,8 +662,18 @@ fn csv(rows: &[Row]) -> String {
         "class,kernel,layout,backend,ns_per_box_cache,ns_per_box_dram,worst_error_us,contains_fraction,mean_volume_overhead,ratio_to_fastest\n",
     );
     for r in rows {
-        let a = r.accuracy.map_or(",,".to_string(), |a| format!("{:.6},{:.6},{:.6e}", a.worst_error_us, a.contains, a.overhead));
-        writeln!(s, "{},{},{},{},{:.4},{:.4},{},{:.4}", r.class, r.kernel, r.layout, r.backend, r.ns_cache, r.ns_dram, a, r.ratio).unwrap();
+        let a = r.accuracy.map_or(",,".to_string(), |a| {
+            format!(
+                "{:.6},{:.6},{:.6e}",
+                a.worst_error_us, a.contains, a.overhead
+            )
+        });
+        writeln!(
+            s,
+            "{},{},{},{},{:.4},{:.4},{},{:.4}",
+            r.class, r.kernel, r.layout, r.backend, r.ns_cache, r.ns_dram, a, r.ratio
+        )
+        .unwrap();
     }
     s
 }
@@ -390,19 +688,36 @@ fn recommendations(rows: &[Row]) -> String {
         ("scaled props (3D)", "3D affine"),
         ("sheared / skinned (3D)", "3D affine"),
     ];
-    let mut s = String::from("| scene profile | must contain (fastest Outward) | a few ulps is fine (fastest Nearest within 8 u·S) |\n|---|---|---|\n");
+    let mut s = String::from(
+        "| scene profile | must contain (fastest Outward) | a few ulps is fine (fastest Nearest within 8 u·S) |\n|---|---|---|\n",
+    );
     let describe = |r: &Row| {
         let a = r.accuracy.expect("kernel rows carry accuracy");
         format!(
             "{} {} {} — {:.2} ns/box cache, {:.2} DRAM; worst {:.2} u·S, contains {}",
-            r.kernel, r.layout, r.backend, r.ns_cache, r.ns_dram, a.worst_error_us, pct(a.contains)
+            r.kernel,
+            r.layout,
+            r.backend,
+            r.ns_cache,
+            r.ns_dram,
+            a.worst_error_us,
+            pct(a.contains)
         )
     };
     for (profile, class) in profiles {
-        let kernels = || rows.iter().filter(move |r| r.class == class && r.accuracy.is_some() && r.method.is_some());
-        let fastest = |it: &mut dyn Iterator<Item = &Row>| it.min_by(|a, b| a.ns_cache.total_cmp(&b.ns_cache)).map(describe).unwrap_or_default();
+        let kernels = || {
+            rows.iter()
+                .filter(move |r| r.class == class && r.accuracy.is_some() && r.method.is_some())
+        };
+        let fastest = |it: &mut dyn Iterator<Item = &Row>| {
+            it.min_by(|a, b| a.ns_cache.total_cmp(&b.ns_cache))
+                .map(describe)
+                .unwrap_or_default()
+        };
         let must = fastest(&mut kernels().filter(|r| r.accuracy.unwrap().contains == 1.0));
-        let ulps = fastest(&mut kernels().filter(|r| r.rounding == Some(Rounding::Nearest) && r.accuracy.unwrap().worst_error_us <= 8.0));
+        let ulps = fastest(&mut kernels().filter(|r| {
+            r.rounding == Some(Rounding::Nearest) && r.accuracy.unwrap().worst_error_us <= 8.0
+        }));
         writeln!(s, "| {profile} | {must} | {ulps} |").unwrap();
     }
     s.push_str("\nThe 3D profiles share the affine kernels: bvkit has no dedicated 3D rigid or scale-only kernel yet, so they get the same figures; the sample covers rotations, reflections, scale, shear and drift alike.\n");
@@ -413,18 +728,33 @@ fn recommendations(rows: &[Row]) -> String {
 /// kernel (best backend and scalar), coloured by method, filled for Nearest, hollow for
 /// Outward; peers as grey crosses.
 fn svg(rows: &[Row]) -> String {
-    let points: Vec<&Row> = rows.iter().filter(|r| r.accuracy.is_some() && r.backend != "peer").collect();
+    let points: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.accuracy.is_some() && r.backend != "peer")
+        .collect();
     let (w, h, left, right, top, bottom) = (960.0, 600.0, 80.0, 40.0, 50.0, 70.0);
     let (pw, ph) = (w - left - right, h - top - bottom);
     let lx = |ns: f64| ns.max(1e-3).log10();
-    let (x0, x1) = points.iter().fold((f64::MAX, f64::MIN), |(a, b), r| (a.min(lx(r.ns_cache)), b.max(lx(r.ns_cache))));
+    let (x0, x1) = points.iter().fold((f64::MAX, f64::MIN), |(a, b), r| {
+        (a.min(lx(r.ns_cache)), b.max(lx(r.ns_cache)))
+    });
     let (x0, x1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0));
-    let y1 = points.iter().map(|r| r.accuracy.unwrap().worst_error_us).fold(1.0, f64::max) * 1.1;
+    let y1 = points
+        .iter()
+        .map(|r| r.accuracy.unwrap().worst_error_us)
+        .fold(1.0, f64::max)
+        * 1.1;
     let px = |ns: f64| left + (lx(ns) - x0) / (x1 - x0) * pw;
     let py = |e: f64| top + ph - e / y1 * ph;
-    let mut s = format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#);
+    let mut s = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#
+    );
     write!(s, r#"<rect width="{w}" height="{h}" fill="white"/><text x="{left}" y="28" font-size="15">bvkit: speed against worst error, every kernel, layout and backend (in-cache batch)</text>"#).unwrap();
-    write!(s, r#"<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#).unwrap();
+    write!(
+        s,
+        r#"<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
+    )
+    .unwrap();
     let mut decade = x0;
     while decade <= x1 {
         let x = left + (decade - x0) / (x1 - x0) * pw;
@@ -433,7 +763,13 @@ fn svg(rows: &[Row]) -> String {
     }
     for k in 0..=5 {
         let e = y1 * f64::from(k) / 5.0;
-        write!(s, r#"<text x="{}" y="{}" text-anchor="end">{e:.1}</text>"#, left - 6.0, py(e) + 4.0).unwrap();
+        write!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="end">{e:.1}</text>"#,
+            left - 6.0,
+            py(e) + 4.0
+        )
+        .unwrap();
     }
     write!(s, r#"<text x="{}" y="{}" text-anchor="middle">ns per box, in cache (median, log scale)</text>"#, left + pw / 2.0, h - 30.0).unwrap();
     write!(s, r#"<text x="18" y="{0}" transform="rotate(-90 18 {0})" text-anchor="middle">worst face error (u·S)</text>"#, top + ph / 2.0).unwrap();
@@ -448,11 +784,44 @@ fn svg(rows: &[Row]) -> String {
         let c = color(r.method);
         let shape = match r.class {
             "3D affine" => format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="5""#),
-            "2D rigid" => format!(r#"<rect x="{:.1}" y="{:.1}" width="9" height="9""#, x - 4.5, y - 4.5),
-            _ => format!(r#"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1}""#, x, y - 6.0, x - 5.5, y + 4.0, x + 5.5, y + 4.0),
+            "2D rigid" => format!(
+                r#"<rect x="{:.1}" y="{:.1}" width="9" height="9""#,
+                x - 4.5,
+                y - 4.5
+            ),
+            _ => format!(
+                r#"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1}""#,
+                x,
+                y - 6.0,
+                x - 5.5,
+                y + 4.0,
+                x + 5.5,
+                y + 4.0
+            ),
         };
-        let paint = if r.rounding == Some(Rounding::Nearest) { format!(r#"fill="{c}""#) } else { format!(r#"fill="none" stroke="{c}" stroke-width="2""#) };
-        write!(s, r#"{shape} {paint}><title>{} {} {} {}: {:.2} ns, {:.2} u·S</title></{}>"#, r.class, r.kernel, r.layout, r.backend, r.ns_cache, r.accuracy.unwrap().worst_error_us, if r.class == "3D affine" { "circle" } else if r.class == "2D rigid" { "rect" } else { "polygon" }).unwrap();
+        let paint = if r.rounding == Some(Rounding::Nearest) {
+            format!(r#"fill="{c}""#)
+        } else {
+            format!(r#"fill="none" stroke="{c}" stroke-width="2""#)
+        };
+        write!(
+            s,
+            r#"{shape} {paint}><title>{} {} {} {}: {:.2} ns, {:.2} u·S</title></{}>"#,
+            r.class,
+            r.kernel,
+            r.layout,
+            r.backend,
+            r.ns_cache,
+            r.accuracy.unwrap().worst_error_us,
+            if r.class == "3D affine" {
+                "circle"
+            } else if r.class == "2D rigid" {
+                "rect"
+            } else {
+                "polygon"
+            }
+        )
+        .unwrap();
     }
     let legend = [
         ("naive", "#d62728"),
@@ -460,7 +829,15 @@ fn svg(rows: &[Row]) -> String {
         ("sign-select", "#2ca02c"),
     ];
     for (i, (name, c)) in legend.iter().enumerate() {
-        write!(s, r#"<circle cx="{}" cy="{}" r="5" fill="{c}"/><text x="{}" y="{}">{name}</text>"#, left + 15.0, top + 18.0 + 18.0 * i as f64, left + 25.0, top + 22.0 + 18.0 * i as f64).unwrap();
+        write!(
+            s,
+            r#"<circle cx="{}" cy="{}" r="5" fill="{c}"/><text x="{}" y="{}">{name}</text>"#,
+            left + 15.0,
+            top + 18.0 + 18.0 * i as f64,
+            left + 25.0,
+            top + 22.0 + 18.0 * i as f64
+        )
+        .unwrap();
     }
     write!(s, r#"<text x="{}" y="{}">filled: Nearest · hollow: Outward · circle: 3D affine · square: 2D rigid · triangle: 2D affine</text>"#, left + 15.0, top + 22.0 + 18.0 * 3.0).unwrap();
     s.push_str("</svg>\n");
@@ -470,7 +847,11 @@ fn svg(rows: &[Row]) -> String {
 fn main() -> std::io::Result<()> {
     let started = Instant::now();
     let best = Backend::detect();
-    let backends: Vec<Backend> = if best == Backend::Scalar { vec![best] } else { vec![best, Backend::Scalar] };
+    let backends: Vec<Backend> = if best == Backend::Scalar {
+        vec![best]
+    } else {
+        vec![best, Backend::Scalar]
+    };
     eprintln!(
         "bvkit trade report: best backend {best:?} (supported: {:?}); {CACHE}-box and {DRAM}-box batches; {} oracle cases per kernel",
         Backend::supported(),
@@ -490,24 +871,45 @@ fn main() -> std::io::Result<()> {
     println!("## Recommendations\n");
     println!("{}", recommendations(&rows));
     let key = |class: &str, kernel: &str, layout: &str, backend: &str| {
-        rows.iter().find(|r| r.class == class && r.kernel == kernel && r.layout == layout && r.backend == backend)
+        rows.iter().find(|r| {
+            r.class == class && r.kernel == kernel && r.layout == layout && r.backend == backend
+        })
     };
     let b = best.name();
     if let (Some(n), Some(o), Some(p), Some(rl)) = (
         key("3D affine", "abs-matrix nearest", "aosoa", b),
         key("3D affine", "abs-matrix outward", "aosoa", b),
-        key("3D affine", "parry3d Aabb::transform_by (rigid)", "aos", "peer"),
+        key(
+            "3D affine",
+            "parry3d Aabb::transform_by (rigid)",
+            "aos",
+            "peer",
+        ),
         key("3D affine", "memory roofline", "aosoa", "roofline"),
     ) {
         println!("## Issue targets, measured in this run\n");
         println!("| figure | measured | target |\n|---|---:|---:|");
-        println!("| abs-matrix nearest AoSoA ({b}), in cache | {:.2} ns/box | <= 0.5 ns/box |", n.ns_cache);
-        println!("| speed-up over the parry3d loop, in cache | {:.1}x | >= 10x |", p.ns_cache / n.ns_cache);
-        println!("| Outward / Nearest (abs-matrix AoSoA), in cache | {:.2}x | <= 1.2x |", o.ns_cache / n.ns_cache);
-        println!("| abs-matrix nearest AoSoA / memory roofline, DRAM | {:.2}x | <= 1.15x |", n.ns_dram / rl.ns_dram);
+        println!(
+            "| abs-matrix nearest AoSoA ({b}), in cache | {:.2} ns/box | <= 0.5 ns/box |",
+            n.ns_cache
+        );
+        println!(
+            "| speed-up over the parry3d loop, in cache | {:.1}x | >= 10x |",
+            p.ns_cache / n.ns_cache
+        );
+        println!(
+            "| Outward / Nearest (abs-matrix AoSoA), in cache | {:.2}x | <= 1.2x |",
+            o.ns_cache / n.ns_cache
+        );
+        println!(
+            "| abs-matrix nearest AoSoA / memory roofline, DRAM | {:.2}x | <= 1.15x |",
+            n.ns_dram / rl.ns_dram
+        );
         println!();
     }
-    let dir = PathBuf::from(std::env::var_os("CARGO_TARGET_DIR").unwrap_or_else(|| "target".into())).join("trade");
+    let dir =
+        PathBuf::from(std::env::var_os("CARGO_TARGET_DIR").unwrap_or_else(|| "target".into()))
+            .join("trade");
     std::fs::create_dir_all(&dir)?;
     let (csv_path, svg_path) = (dir.join("trade.csv"), dir.join("trade.svg"));
     std::fs::write(&csv_path, csv(&rows))?;

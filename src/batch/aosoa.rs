@@ -170,6 +170,17 @@ fn whole<L: LaneArray>(count: usize) -> bool {
     count == L::WIDTH && 8 % L::WIDTH == 0
 }
 
+/// Lanes `slot..slot + L::WIDTH` of three fields of a block: three vector loads (a
+/// function, not a closure, so that it is always inlined).
+#[inline(always)]
+fn fields<L: LaneArray>(f: &[[f32; 8]; 3], slot: usize) -> Vector<L, 3> {
+    Vector([
+        L::load(&f[0][slot..]),
+        L::load(&f[1][slot..]),
+        L::load(&f[2][slot..]),
+    ])
+}
+
 impl BoxSource<3> for &[Aabb3x8] {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(<[Aabb3x8]>::len(self) * 8)
@@ -178,14 +189,7 @@ impl BoxSource<3> for &[Aabb3x8] {
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
         if whole::<L>(count) {
             let (block, slot) = (&self[i / 8], i % 8);
-            let field = |f: &[[f32; 8]; 3]| {
-                Vector([
-                    L::load(&f[0][slot..]),
-                    L::load(&f[1][slot..]),
-                    L::load(&f[2][slot..]),
-                ])
-            };
-            return (field(&block.min), field(&block.max));
+            return (fields(&block.min, slot), fields(&block.max, slot));
         }
         let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
         for k in 0..L::WIDTH {
@@ -252,20 +256,13 @@ impl MapSource<3> for &[Affine3x8] {
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
         if whole::<L>(count) {
             let (block, slot) = (&self[i / 8], i % 8);
-            let field = |f: &[[f32; 8]; 3]| {
-                Vector([
-                    L::load(&f[0][slot..]),
-                    L::load(&f[1][slot..]),
-                    L::load(&f[2][slot..]),
-                ])
-            };
             return AffineLanes {
                 cols: [
-                    field(&block.cols[0]),
-                    field(&block.cols[1]),
-                    field(&block.cols[2]),
+                    fields(&block.cols[0], slot),
+                    fields(&block.cols[1], slot),
+                    fields(&block.cols[2], slot),
                 ],
-                t: field(&block.translation),
+                t: fields(&block.translation, slot),
             };
         }
         let mut map = AffineLanes {

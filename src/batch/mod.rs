@@ -127,22 +127,18 @@ impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Run<B, X, 
         let map = self.xf.load::<L>(i, count);
         let (min, max, stands) = block::transform(&map, lo, hi, method, outward);
         self.out.store(i, count, min, max);
-        // Lanes past `count` hold a zero box through a zero map: they stand.
+        // Lanes past `count` hold a zero box through a zero map: they stand. The rare
+        // others are recomputed from the source data; nothing here takes `&mut self` out
+        // of line, so the layout descriptors stay in registers.
         if stands.any_nonzero() {
-            let redo: [bool; 32] = core::array::from_fn(|k| k < count && stands.get(k).is_nan());
-            self.redo(i, &redo);
-        }
-    }
-
-    /// Recomputes the boxes `i + k` marked in `redo` on the extended path.
-    #[cold]
-    #[inline(never)]
-    fn redo(&mut self, i: usize, redo: &[bool; 32]) {
-        for k in (0..32).filter(|&k| redo[k]) {
-            let (lo, hi) = self.local.get(i + k);
-            let (cols, t) = self.xf.get(i + k);
-            let (min, max) = extended::transform(cols, t, lo, hi, self.rounding);
-            self.out.set(i + k, min, max);
+            for k in 0..count {
+                if stands.get(k) != 0.0 {
+                    let (lo, hi) = self.local.get(i + k);
+                    let (cols, t) = self.xf.get(i + k);
+                    let (min, max) = extended::transform(cols, t, lo, hi, self.rounding);
+                    self.out.set(i + k, min, max);
+                }
+            }
         }
     }
 }
@@ -219,19 +215,7 @@ impl Batch {
         xf: impl MapSource<N>,
         out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
-        let len = local.len()?;
-        let mismatch = |what, found| BatchError::LengthMismatch {
-            what,
-            expected: len,
-            found,
-        };
-        if let Some(n) = xf.len().filter(|&n| n != len) {
-            return Err(mismatch("transforms", n));
-        }
-        let out_len = out.len()?;
-        if out_len != len {
-            return Err(mismatch("output", out_len));
-        }
+        let len = checked_len(&local, &xf, &out)?;
         let job: Run<_, _, _, N> = Run {
             local,
             xf,
@@ -244,6 +228,39 @@ impl Batch {
         Ok(())
     }
 
+    /// AoS 3D boxes one at a time on the single-box SIMD kernel (lanes = axes):
+    /// transposing AoS boxes into box lanes costs more than the lanes save. The scalar
+    /// backend keeps the lane path, which is the scalar reference.
+    fn per_box(&self, local: &[Aabb3], xf: impl Fn(usize) -> Affine3A, out: &mut [Aabb3]) {
+        for (i, (b, o)) in local.iter().zip(out).enumerate() {
+            *o = b.transformed(&xf(i), self.method, self.rounding);
+        }
+    }
+}
+
+/// The common length of a batch, checked before anything is written.
+fn checked_len<const N: usize>(
+    local: &impl BoxSource<N>,
+    xf: &impl MapSource<N>,
+    out: &impl BoxSink<N>,
+) -> Result<usize, BatchError> {
+    let len = local.len()?;
+    let mismatch = |what, found| BatchError::LengthMismatch {
+        what,
+        expected: len,
+        found,
+    };
+    if let Some(n) = xf.len().filter(|&n| n != len) {
+        return Err(mismatch("transforms", n));
+    }
+    let out_len = out.len()?;
+    if out_len != len {
+        return Err(mismatch("output", out_len));
+    }
+    Ok(len)
+}
+
+impl Batch {
     /// AoSoA blocks, one transform block per box block: the fast path.
     ///
     /// # Errors
@@ -306,7 +323,12 @@ impl Batch {
         xf: &[Affine3A],
         out: &mut [Aabb3],
     ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
+        if self.backend == Backend::Scalar {
+            return self.run(local, xf, out);
+        }
+        checked_len::<3>(&local, &xf, &out)?;
+        self.per_box(local, |i| xf[i], out);
+        Ok(())
     }
 
     /// AoS slices through one shared transform (compound bodies, instanced props).
@@ -319,7 +341,12 @@ impl Batch {
         xf: &Affine3A,
         out: &mut [Aabb3],
     ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
+        if self.backend == Backend::Scalar {
+            return self.run(local, xf, out);
+        }
+        checked_len::<3>(&local, &xf, &out)?;
+        self.per_box(local, |_| *xf, out);
+        Ok(())
     }
 
     /// 2D AoS slices, one affine transform per box.

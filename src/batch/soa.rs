@@ -141,6 +141,17 @@ fn common_len(
     }
 }
 
+/// Lanes `i..i + L::WIDTH` of three columns: three vector loads. A function, not a
+/// closure: closures in the loaders were left outlined, which stops vectorisation.
+#[inline(always)]
+fn columns<L: LaneArray>(c: &[&[f32]; 3], i: usize) -> Vector<L, 3> {
+    Vector([
+        L::load(&c[0][i..]),
+        L::load(&c[1][i..]),
+        L::load(&c[2][i..]),
+    ])
+}
+
 impl BoxSource<3> for AabbSoaRef<'_> {
     fn len(&self) -> Result<usize, BatchError> {
         common_len(
@@ -151,14 +162,7 @@ impl BoxSource<3> for AabbSoaRef<'_> {
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
         if count == L::WIDTH {
-            let column = |c: &[&[f32]; 3]| {
-                Vector([
-                    L::load(&c[0][i..]),
-                    L::load(&c[1][i..]),
-                    L::load(&c[2][i..]),
-                ])
-            };
-            return (column(&self.min), column(&self.max));
+            return (columns(&self.min, i), columns(&self.max, i));
         }
         let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
         for a in 0..3 {
@@ -231,20 +235,13 @@ impl MapSource<3> for Affine3SoaRef<'_> {
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
         if count == L::WIDTH {
-            let column = |c: &[&[f32]; 3]| {
-                Vector([
-                    L::load(&c[0][i..]),
-                    L::load(&c[1][i..]),
-                    L::load(&c[2][i..]),
-                ])
-            };
             return AffineLanes {
                 cols: [
-                    column(&self.cols[0]),
-                    column(&self.cols[1]),
-                    column(&self.cols[2]),
+                    columns(&self.cols[0], i),
+                    columns(&self.cols[1], i),
+                    columns(&self.cols[2], i),
                 ],
-                t: column(&self.translation),
+                t: columns(&self.translation, i),
             };
         }
         let mut map = AffineLanes {
