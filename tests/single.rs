@@ -145,3 +145,35 @@ fn every_class_meets_the_contract() {
         }
     }
 }
+
+/// The certified-f64 shortcut of the oracle agrees with the exact oracle wherever it
+/// answers, on results that are right and on results nudged to be wrong.
+#[test]
+fn certified_oracle_agrees_with_exact() {
+    let mut answered = 0;
+    for class in Class::ALL {
+        for seed in 0..300 {
+            let p = problem::<3>(class, &mut rng(seed ^ 0xce57));
+            let (b, xf) = affine3(&p);
+            for method in Method::ALL {
+                for rounding in Rounding::ALL {
+                    let out = b.transformed(&xf, method, rounding);
+                    let bound = bound(method, rounding, 3);
+                    for nudge in [0, 1, 3] {
+                        let min = out.min.to_array().map(|x| (0..nudge).fold(x, |y, _| y.next_up()));
+                        let max = out.max.to_array().map(|x| (0..nudge).fold(x, |y, _| y.next_down()));
+                        let fast = check(&p, min, max, bound);
+                        let exact = oracle::check_exact(&p, min, max, bound);
+                        assert_eq!(fast.is_ok(), exact.is_ok(), "{p:?} {method:?} {rounding:?} nudge {nudge}");
+                        if let (Ok(f), Ok(e)) = (fast, exact) {
+                            answered += 1;
+                            assert_eq!(f.contains, e.contains, "{p:?}");
+                            assert!((f.worst_error_us - e.worst_error_us).abs() <= 1e-6 * e.worst_error_us.max(1.0));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(answered > 10_000, "the comparison must have run: {answered}");
+}

@@ -308,6 +308,95 @@ pub fn check<const N: usize>(
     max: [f32; N],
     bound: Bound,
 ) -> Result<Measured, String> {
+    if let Some(measured) = check_certified_f64(p, min, max, bound) {
+        return Ok(measured);
+    }
+    check_exact(p, min, max, bound)
+}
+
+/// The same verdict as [`check_exact`] when `f64` arithmetic with a rigorous error bound
+/// decides every comparison; `None` (undecided, or a failure to report exactly) otherwise.
+///
+/// For finite inputs each product of two `f32` is exact in `f64` and the sum of `N + 1`
+/// terms errs by at most `N·2^-53` times the sum of their magnitudes; the bound used here
+/// is twice that plus the smallest normal `f64`, which also covers the rounding of the
+/// comparisons themselves. Only verdicts that hold for every value within the bound are
+/// returned, so the oracle stays exact; it is only faster where nothing is close.
+fn check_certified_f64<const N: usize>(
+    p: &Problem<N>,
+    min: [f32; N],
+    max: [f32; N],
+    bound: Bound,
+) -> Option<Measured> {
+    let all = p
+        .cols
+        .iter()
+        .flatten()
+        .chain(&p.t)
+        .chain(&p.lo)
+        .chain(&p.hi);
+    if !all.clone().all(|x| x.is_finite()) || p.is_empty() {
+        return None;
+    }
+    if !min.iter().chain(&max).all(|x| x.is_finite()) {
+        return None;
+    }
+    let mut measured = Measured {
+        contains: true,
+        ..Measured::default()
+    };
+    let (mut exact_volume, mut volume) = (1.0f64, 1.0f64);
+    for i in 0..N {
+        let t = f64::from(p.t[i]);
+        let (mut lo, mut hi, mut magnitude) = (t, t, t.abs());
+        for j in 0..N {
+            let m = f64::from(p.cols[j][i]);
+            let (a, b) = (m * f64::from(p.lo[j]), m * f64::from(p.hi[j]));
+            lo += a.min(b);
+            hi += a.max(b);
+            magnitude += a.abs().max(b.abs());
+        }
+        let error =
+            2.0 * (N as f64 + 1.0) * f64::EPSILON / 2.0 * magnitude * 1.001 + f64::MIN_POSITIVE;
+        let allowance = bound.allowance(magnitude * (1.0 - 1e-9));
+        for (face, exact, lower) in [(min[i], lo, true), (max[i], hi, false)] {
+            let face = f64::from(face);
+            let gap = face - exact; // exact − face is within ±error of the true difference
+            if matches!(bound, Bound::Outward { .. }) {
+                let contained = if lower { gap < -error } else { gap > error };
+                if !contained {
+                    return None; // undecided, or broken: the exact check reports it
+                }
+            } else {
+                let outside = if lower { gap > error } else { gap < -error };
+                let inside = if lower { gap < -error } else { gap > error };
+                if !(outside || inside) {
+                    return None;
+                }
+                measured.contains &= inside;
+            }
+            if gap.abs() + error > allowance {
+                return None;
+            }
+            let unit = U * magnitude + f64::from(f32::from_bits(1));
+            measured.worst_error_us = measured.worst_error_us.max(gap.abs() / unit);
+        }
+        exact_volume *= hi - lo;
+        volume *= f64::from(max[i]) - f64::from(min[i]);
+    }
+    if exact_volume > 0.0 && exact_volume.is_finite() && volume.is_finite() {
+        measured.overhead = Some(volume / exact_volume - 1.0);
+    }
+    Some(measured)
+}
+
+/// Checks a result against the contract in exact arithmetic and measures it.
+pub fn check_exact<const N: usize>(
+    p: &Problem<N>,
+    min: [f32; N],
+    max: [f32; N],
+    bound: Bound,
+) -> Result<Measured, String> {
     match p.expected() {
         Expected::Invalid => {
             if min.iter().chain(&max).any(|x| x.is_nan()) {

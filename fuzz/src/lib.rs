@@ -1,0 +1,141 @@
+//! Decoding of fuzz input into boxes and transforms, and the contract checks every fuzz
+//! target applies (through the exact oracle of `tests/oracle`).
+
+#[path = "../../tests/oracle/mod.rs"]
+pub mod oracle;
+
+use bvkit::method::{TINY_ERROR, TINY_PAD};
+use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
+use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use oracle::{Bound, Problem};
+
+/// Values that the extreme classes are made of.
+const SPECIALS: [f32; 16] = [
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::NAN,
+    f32::MAX,
+    -f32::MAX,
+    f32::MIN_POSITIVE,
+    1e-45,
+    -1e-45,
+    1e7,
+    1e9,
+    0.70710677,
+    1e-7,
+];
+
+/// Reads floats from fuzz bytes: a selector byte then four bytes, so that raw bit
+/// patterns, moderate values, the extreme specials and near-rotation entries all occur.
+pub struct Floats<'a> {
+    bytes: &'a [u8],
+}
+
+impl<'a> Floats<'a> {
+    pub fn new(bytes: &'a [u8]) -> Self {
+        Self { bytes }
+    }
+
+    pub fn byte(&mut self) -> u8 {
+        match self.bytes.split_first() {
+            Some((&b, rest)) => {
+                self.bytes = rest;
+                b
+            }
+            None => 0,
+        }
+    }
+
+    pub fn next(&mut self) -> f32 {
+        let selector = self.byte();
+        let raw = u32::from_le_bytes([self.byte(), self.byte(), self.byte(), self.byte()]);
+        match selector % 5 {
+            0 => f32::from_bits(raw),
+            1 => (raw as i32 >> 12) as f32 / 64.0,
+            2 => SPECIALS[raw as usize % SPECIALS.len()],
+            3 => ((raw % 20_001) as f32 - 10_000.0) / 10_000.0, // a rotation-like entry
+            _ => SPECIALS[raw as usize % SPECIALS.len()] * (1.0 + (raw >> 8) as f32 * 1e-9),
+        }
+    }
+
+    pub fn array<const N: usize>(&mut self) -> [f32; N] {
+        core::array::from_fn(|_| self.next())
+    }
+
+    /// A problem: usually an ordered box (the fuzzer still reaches unordered ones).
+    pub fn problem<const N: usize>(&mut self) -> Problem<N> {
+        let cols = core::array::from_fn(|_| self.array());
+        let t = self.array();
+        let (mut lo, mut hi): ([f32; N], [f32; N]) = (self.array(), self.array());
+        if self.byte() % 4 != 0 {
+            for j in 0..N {
+                if lo[j] > hi[j] {
+                    core::mem::swap(&mut lo[j], &mut hi[j]);
+                }
+            }
+        }
+        Problem { cols, t, lo, hi }
+    }
+}
+
+pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
+    match rounding {
+        Rounding::Nearest => Bound::Nearest {
+            gamma_n: method.nearest_gamma(dims),
+            tiny: f64::from(TINY_ERROR),
+        },
+        Rounding::Outward => Bound::Outward {
+            k: method.outward_pad(dims),
+            tiny: f64::from(TINY_PAD),
+        },
+    }
+}
+
+/// Panics with the problem when `min`/`max` break the contract.
+pub fn assert_contract<const N: usize>(
+    p: &Problem<N>,
+    min: [f32; N],
+    max: [f32; N],
+    bound: Bound,
+    what: &str,
+) {
+    if let Err(e) = oracle::check(p, min, max, bound) {
+        panic!("{what}: {e}\n{p:?}");
+    }
+}
+
+pub fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
+    let [x, y, z] = p.cols.map(Vec3A::from_array);
+    let xf = Affine3A {
+        matrix3: Mat3A::from_cols(x, y, z),
+        translation: Vec3A::from_array(p.t),
+    };
+    (
+        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
+        xf,
+    )
+}
+
+pub fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
+    let [x, y] = p.cols.map(Vec2::from_array);
+    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
+    (
+        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
+        xf,
+    )
+}
+
+/// A rigid problem: the matrix is rebuilt from its first column as `[[c, -s], [s, c]]`.
+pub fn rigid2(p: &Problem<2>) -> (Problem<2>, Aabb2, Rigid2) {
+    let [c, s] = p.cols[0];
+    let q = Problem {
+        cols: [[c, s], [-s, c]],
+        ..*p
+    };
+    let b = Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi));
+    (q, b, Rigid2::new(c, s, Vec2::from_array(p.t)))
+}

@@ -1,0 +1,80 @@
+#!/usr/bin/env python3
+"""Writes the fuzz seed corpora (fuzz/seeds/TARGET/*): one input per extreme class, in the
+byte encoding of fuzz/src/lib.rs (a selector byte 0 then the f32 bits, little-endian).
+Run from the repository root: python3 scripts/make_seeds.py"""
+import math
+import pathlib
+import struct
+
+MAX = 3.4028234663852886e38
+INF = float("inf")
+NAN = float("nan")
+TINY = 1.401298464324817e-45  # 2^-149
+
+
+def f(x):
+    return b"\x00" + struct.pack("<f", x)
+
+
+def problem3(cols, t, lo, hi, order=1):
+    return b"".join(f(x) for c in cols for x in c) + b"".join(map(f, t + lo + hi)) + bytes([order])
+
+
+def problem2(cols, t, lo, hi, order=1):
+    return b"".join(f(x) for c in cols for x in c) + b"".join(map(f, t + lo + hi)) + bytes([order])
+
+
+def rot3(a, noise=0.0):
+    c, s = math.cos(a), math.sin(a)
+    return [[c, s + noise, noise], [-s, c, noise], [noise, 0.0, 1.0]]
+
+
+I3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+classes3 = {
+    "far_1e3": (rot3(0.3), [1e3, -1e3, 1e3], [-0.01] * 3, [0.01] * 3),
+    "far_1e5": (rot3(0.3), [1e5, -1e5, 1e5], [-0.01] * 3, [0.01] * 3),
+    "far_1e7": (rot3(0.3), [1e7, -1e7, 1e7], [-0.01] * 3, [0.01] * 3),
+    "far_1e9": (rot3(0.3), [1e9, -1e9, 1e9], [-0.01] * 3, [0.01] * 3),
+    "near_max": (rot3(0.7), [0.0] * 3, [-3e38] * 3, [3e38] * 3),
+    "overflow": ([[10.0, 0, 0], [0, 10.0, 0], [0, 0, 10.0]], [0.0] * 3, [1e38] * 3, [2e38] * 3),
+    "subnormal": ([[TINY, 0, 0], [0, 1.0, 0], [0, 0, 1e30]], [TINY] * 3, [TINY] * 3, [3 * TINY] * 3),
+    "zero_size": (rot3(1.1), [1.0, 2.0, 3.0], [0.5] * 3, [0.5] * 3),
+    "signed_zero": ([[-0.0, 0.0, 1.0], [0.0, -0.0, 0.0], [1.0, 0.0, -0.0]], [-0.0, 0.0, -0.0], [-0.0] * 3, [0.0] * 3),
+    "quarter_turn": (rot3(math.pi / 2, 1e-7), [0.0] * 3, [-1.0] * 3, [1.0] * 3),
+    "drifted": ([[x * 1.001 for x in c] for c in rot3(0.4)], [1.0] * 3, [-1.0] * 3, [1.0] * 3),
+    "reflection": ([[-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]], [0.0] * 3, [-1.0, 0.0, 1.0], [2.0, 1.0, 3.0]),
+    "near_singular": ([[1e-7, 0, 0], [0, 1e7, 0], [0, 0, 0.0]], [0.0] * 3, [-1.0] * 3, [1.0] * 3),
+    "shear": ([[1.0, 0, 0], [5.0, 1.0, 0], [0, -3.0, 1.0]], [0.0] * 3, [-1.0] * 3, [1.0] * 3),
+    "unbounded": (I3, [1.0, 2.0, 3.0], [-INF, 0.0, 0.0], [INF, 1.0, 1.0]),
+    "empty": (rot3(0.2), [0.0] * 3, [INF] * 3, [-INF] * 3),
+    "nan": (rot3(0.2), [NAN, 0.0, 0.0], [0.0] * 3, [1.0] * 3),
+}
+
+root = pathlib.Path("fuzz/seeds")
+for target in ["affine3", "affine2", "rigid2", "mat4", "batch"]:
+    (root / target).mkdir(parents=True, exist_ok=True)
+
+for name, (cols, t, lo, hi) in classes3.items():
+    order = 0 if name == "empty" else 1  # 0 keeps min > max as given
+    data3 = problem3(cols, t, lo, hi, order)
+    (root / "affine3" / name).write_bytes(data3)
+    cols2 = [c[:2] for c in cols[:2]]
+    data2 = problem2(cols2, t[:2], lo[:2], hi[:2], order)
+    (root / "affine2" / name).write_bytes(data2)
+    (root / "rigid2" / name).write_bytes(data2)
+    # batch: backend, method, rounding bytes, n, then n 3D and n 2D problems.
+    (root / "batch" / name).write_bytes(bytes([0, 1, 1, 9]) + data3 * 9 + data2 * 9)
+
+# mat4: 16 column-major entries, the "make affine" byte, then the box.
+def mat4(cols, lo, hi, make_affine):
+    return b"".join(f(x) for c in cols for x in c) + bytes([make_affine]) + b"".join(map(f, lo + hi))
+
+
+perspective = [[1.0, 0, 0, 0], [0, 1.5, 0, 0], [0, 0, -1.0, -1.0], [0, 0, -0.1, 0.0]]
+(root / "mat4" / "projective_in_front").write_bytes(mat4(perspective, [-1.0, -1.0, -5.0], [1.0, 1.0, -2.0], 1))
+(root / "mat4" / "projective_behind_eye").write_bytes(mat4(perspective, [-1.0, -1.0, -5.0], [1.0, 1.0, 1.0], 1))
+(root / "mat4" / "non_affine_row").write_bytes(mat4([[1.0, 0, 0, 0.5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], [0.0] * 3, [1.0] * 3, 1))
+(root / "mat4" / "affine").write_bytes(mat4([[0.0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 1, 0], [5, 6, 7, 1]], [-1.0] * 3, [1.0] * 3, 0))
+(root / "mat4" / "nan_entry").write_bytes(mat4([[NAN, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], [0.0] * 3, [1.0] * 3, 0))
+(root / "mat4" / "unbounded_projective").write_bytes(mat4(perspective, [-1.0, -1.0, -INF], [1.0, 1.0, -1.0], 1))
+print("seeds written under", root)
