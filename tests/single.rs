@@ -160,20 +160,36 @@ fn certified_oracle_agrees_with_exact() {
                     let out = b.transformed(&xf, method, rounding);
                     let bound = bound(method, rounding, 3);
                     for nudge in [0, 1, 3] {
-                        let min = out.min.to_array().map(|x| (0..nudge).fold(x, |y, _| y.next_up()));
-                        let max = out.max.to_array().map(|x| (0..nudge).fold(x, |y, _| y.next_down()));
+                        let min = out
+                            .min
+                            .to_array()
+                            .map(|x| (0..nudge).fold(x, |y, _| y.next_up()));
+                        let max = out
+                            .max
+                            .to_array()
+                            .map(|x| (0..nudge).fold(x, |y, _| y.next_down()));
                         let fast = check(&p, min, max, bound);
                         let exact = oracle::check_exact(&p, min, max, bound);
-                        assert_eq!(fast.is_ok(), exact.is_ok(), "{p:?} {method:?} {rounding:?} nudge {nudge}");
+                        assert_eq!(
+                            fast.is_ok(),
+                            exact.is_ok(),
+                            "{p:?} {method:?} {rounding:?} nudge {nudge}"
+                        );
                         if let (Ok(f), Ok(e)) = (fast, exact) {
                             answered += 1;
                             assert_eq!(f.contains, e.contains, "{p:?}");
-                            assert!((f.worst_error_us - e.worst_error_us).abs() <= 1e-6 * e.worst_error_us.max(1.0));
+                            assert!(
+                                (f.worst_error_us - e.worst_error_us).abs()
+                                    <= 1e-6 * e.worst_error_us.max(1.0)
+                            );
                         }
                     }
                 }
             }
         }
     }
-    assert!(answered > 10_000, "the comparison must have run: {answered}");
+    assert!(
+        answered > 10_000,
+        "the comparison must have run: {answered}"
+    );
 }
