@@ -16,11 +16,8 @@ use super::oracle::{Bound, Expected, Problem, check};
 /// Cases per cell.
 pub const CASES: u64 = 400;
 
-/// An extreme class: a name and a generator of `N`-dimensional problems.
-pub struct Row {
-    pub name: &'static str,
-    pub make: fn(&mut StdRng, usize) -> Problem<3>,
-}
+/// A generator of the problems of one extreme class.
+type Generator = Box<dyn Fn(&mut StdRng) -> Problem<3>>;
 
 fn from_class(class: Class) -> impl Fn(&mut StdRng) -> Problem<3> {
     move |r| problem::<3>(class, r)
@@ -47,7 +44,7 @@ fn huge_scale(r: &mut StdRng) -> Problem<3> {
 }
 
 /// Rows of the matrix, in the order of the list.
-pub fn rows() -> Vec<(&'static str, Box<dyn Fn(&mut StdRng) -> Problem<3>>)> {
+pub fn rows() -> Vec<(&'static str, Generator)> {
     vec![
         ("far: t = ±1e3", Box::new(|r: &mut StdRng| far(r, 3))),
         ("far: t = ±1e5", Box::new(|r: &mut StdRng| far(r, 5))),
