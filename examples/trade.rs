@@ -26,14 +26,13 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
 use bvkit::{
     Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rigid2, Rounding,
 };
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use glam::{Affine2, Affine3A, Vec2};
 
 use cases::{Class, problem, rigid_problem, rng};
-use oracle::{Bound, Problem, check};
+use oracle::{Bound, Problem, affine2, affine3, check, rigid2};
 
 /// The seed of every random sample: the accuracy columns are identical run to run.
 const SEED: u64 = 0xb0c5_2026;
@@ -77,19 +76,6 @@ struct Accuracy {
     worst_error_us: f64,
     contains: f64,
     overhead: f64,
-}
-
-fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
-    match rounding {
-        Rounding::Nearest => Bound::Nearest {
-            gamma_n: method.nearest_gamma(dims),
-            tiny: f64::from(TINY_ERROR),
-        },
-        Rounding::Outward => Bound::Outward {
-            k: method.outward_pad(dims),
-            tiny: f64::from(TINY_PAD),
-        },
-    }
 }
 
 /// The median ns per box of `reps` runs of `run` over `n` boxes.
@@ -150,34 +136,6 @@ fn accuracy<const N: usize>(
         contains: contained as f64 / sample.len() as f64,
         overhead: overhead_sum / overhead_count as f64,
     }
-}
-
-fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
-    let [x, y, z] = p.cols.map(Vec3A::from_array);
-    let xf = Affine3A {
-        matrix3: Mat3A::from_cols(x, y, z),
-        translation: Vec3A::from_array(p.t),
-    };
-    (
-        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
-        xf,
-    )
-}
-
-fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
-    let [x, y] = p.cols.map(Vec2::from_array);
-    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
-    (
-        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
-        xf,
-    )
-}
-
-fn rigid2(p: &Problem<2>) -> (Aabb2, Rigid2) {
-    (
-        affine2(p).0,
-        Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)),
-    )
 }
 
 fn flat3(b: &Aabb3) -> ([f32; 3], [f32; 3]) {
@@ -335,7 +293,7 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
     for method in Method::ALL {
         for rounding in Rounding::ALL {
             let kernel = format!("{} {}", method.name(), rounding.name());
-            let b3 = bound(method, rounding, 3);
+            let b3 = Bound::documented(method, rounding, 3);
             progress(&format!("3D {kernel}"));
             let t = times(|n| {
                 for ((b, xf), o) in black_box(&boxes[..n])
@@ -501,7 +459,7 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
     for method in Method::ALL {
         for rounding in Rounding::ALL {
             let kernel = format!("{} {}", method.name(), rounding.name());
-            let b2 = bound(method, rounding, 2);
+            let b2 = Bound::documented(method, rounding, 2);
             progress(&format!("2D {kernel}"));
             let t = times(|n| {
                 for ((b, xf), o) in black_box(&boxes[..n])

@@ -4,31 +4,17 @@
 mod cases;
 mod oracle;
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
 use bvkit::{
     Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, BatchError, Method,
     Rigid2, Rounding, transform_slice,
 };
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use glam::{Affine2, Affine3A, Vec2, Vec3A};
 use rand::RngExt;
 
 use cases::{Class, problem, rigid_problem, rng};
-use oracle::{Bound, Problem, check};
+use oracle::{Bound, Problem, affine2, affine3, check};
 
 const LENGTHS: [usize; 8] = [0, 1, 7, 8, 9, 63, 1000, 0];
-
-fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
-    match rounding {
-        Rounding::Nearest => Bound::Nearest {
-            gamma_n: method.nearest_gamma(dims),
-            tiny: f64::from(TINY_ERROR),
-        },
-        Rounding::Outward => Bound::Outward {
-            k: method.outward_pad(dims),
-            tiny: f64::from(TINY_PAD),
-        },
-    }
-}
 
 /// Problems of mixed classes, so that lanes of one block take different paths.
 fn problems<const N: usize>(
@@ -47,25 +33,6 @@ fn problems<const N: usize>(
             make(class, r)
         })
         .collect()
-}
-
-fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
-    let [x, y, z] = p.cols.map(Vec3A::from_array);
-    (
-        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
-        Affine3A {
-            matrix3: Mat3A::from_cols(x, y, z),
-            translation: Vec3A::from_array(p.t),
-        },
-    )
-}
-
-fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
-    let [x, y] = p.cols.map(Vec2::from_array);
-    (
-        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
-        Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t)),
-    )
 }
 
 /// Same faces: equal values (min/max may pick either zero of `max(+0, -0)`), NaN as NaN.
@@ -104,7 +71,7 @@ fn check3(
             p,
             o.min.to_array(),
             o.max.to_array(),
-            bound(method, rounding, 3),
+            Bound::documented(method, rounding, 3),
         ) {
             panic!("{name} box {k}: {e}\n{p:?}");
         }
@@ -131,7 +98,7 @@ fn check2(
             p,
             o.min.to_array(),
             o.max.to_array(),
-            bound(method, rounding, 2),
+            Bound::documented(method, rounding, 2),
         ) {
             panic!("{name} box {k}: {e}\n{p:?}");
         }

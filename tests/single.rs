@@ -4,48 +4,12 @@
 mod cases;
 mod oracle;
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
-use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use bvkit::{Method, Rigid2, Rounding};
+use glam::Vec2;
 use proptest::prelude::*;
 
 use cases::{Class, problem, rigid_problem, rng};
-use oracle::{Bound, Problem, check};
-
-/// The bound `method` documents for `rounding` in `dims` dimensions.
-fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
-    match rounding {
-        Rounding::Nearest => Bound::Nearest {
-            gamma_n: method.nearest_gamma(dims),
-            tiny: f64::from(TINY_ERROR),
-        },
-        Rounding::Outward => Bound::Outward {
-            k: method.outward_pad(dims),
-            tiny: f64::from(TINY_PAD),
-        },
-    }
-}
-
-fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
-    let [x, y, z] = p.cols.map(Vec3A::from_array);
-    let xf = Affine3A::from_mat3_translation(
-        Mat3A::from_cols(x, y, z).into(),
-        Vec3A::from_array(p.t).into(),
-    );
-    (
-        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
-        xf,
-    )
-}
-
-fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
-    let [x, y] = p.cols.map(Vec2::from_array);
-    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
-    (
-        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
-        xf,
-    )
-}
+use oracle::{Bound, Problem, affine2, affine3, check};
 
 fn check_affine3(p: &Problem<3>) -> Result<(), String> {
     let (b, xf) = affine3(p);
@@ -60,7 +24,7 @@ fn check_affine3(p: &Problem<3>) -> Result<(), String> {
                     p,
                     out.min.to_array(),
                     out.max.to_array(),
-                    bound(method, rounding, 3),
+                    Bound::documented(method, rounding, 3),
                 )
                 .map_err(|e| format!("{method:?} {rounding:?} {path}: {e}\n{p:?}"))?;
             }
@@ -78,7 +42,7 @@ fn check_affine2(p: &Problem<2>) -> Result<(), String> {
                 p,
                 out.min.to_array(),
                 out.max.to_array(),
-                bound(method, rounding, 2),
+                Bound::documented(method, rounding, 2),
             )
             .map_err(|e| format!("{method:?} {rounding:?}: {e}\n{p:?}"))?;
         }
@@ -96,7 +60,7 @@ fn check_rigid2(p: &Problem<2>) -> Result<(), String> {
                 p,
                 out.min.to_array(),
                 out.max.to_array(),
-                bound(method, rounding, 2),
+                Bound::documented(method, rounding, 2),
             )
             .map_err(|e| format!("{method:?} {rounding:?}: {e}\n{p:?}"))?;
         }
@@ -158,7 +122,7 @@ fn certified_oracle_agrees_with_exact() {
             for method in Method::ALL {
                 for rounding in Rounding::ALL {
                     let out = b.transformed(&xf, method, rounding);
-                    let bound = bound(method, rounding, 3);
+                    let bound = Bound::documented(method, rounding, 3);
                     for nudge in [0, 1, 3] {
                         let min = out
                             .min

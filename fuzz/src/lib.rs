@@ -4,10 +4,10 @@
 #[path = "../../tests/oracle/mod.rs"]
 pub mod oracle;
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
-use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use bvkit::{Aabb2, Method, Rigid2, Rounding};
 use oracle::{Bound, Problem};
+
+pub use oracle::{affine2, affine3};
 
 /// Values that the extreme classes are made of.
 const SPECIALS: [f32; 16] = [
@@ -82,19 +82,6 @@ impl<'a> Floats<'a> {
     }
 }
 
-pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
-    match rounding {
-        Rounding::Nearest => Bound::Nearest {
-            gamma_n: method.nearest_gamma(dims),
-            tiny: f64::from(TINY_ERROR),
-        },
-        Rounding::Outward => Bound::Outward {
-            k: method.outward_pad(dims),
-            tiny: f64::from(TINY_PAD),
-        },
-    }
-}
-
 /// Panics with the problem when `min`/`max` break the contract.
 pub fn assert_contract<const N: usize>(
     p: &Problem<N>,
@@ -108,27 +95,6 @@ pub fn assert_contract<const N: usize>(
     }
 }
 
-pub fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
-    let [x, y, z] = p.cols.map(Vec3A::from_array);
-    let xf = Affine3A {
-        matrix3: Mat3A::from_cols(x, y, z),
-        translation: Vec3A::from_array(p.t),
-    };
-    (
-        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
-        xf,
-    )
-}
-
-pub fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
-    let [x, y] = p.cols.map(Vec2::from_array);
-    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
-    (
-        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
-        xf,
-    )
-}
-
 /// A rigid problem: the matrix is rebuilt from its first column as `[[c, -s], [s, c]]`.
 pub fn rigid2(p: &Problem<2>) -> (Problem<2>, Aabb2, Rigid2) {
     let [c, s] = p.cols[0];
@@ -136,6 +102,11 @@ pub fn rigid2(p: &Problem<2>) -> (Problem<2>, Aabb2, Rigid2) {
         cols: [[c, s], [-s, c]],
         ..*p
     };
-    let b = Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi));
-    (q, b, Rigid2::new(c, s, Vec2::from_array(p.t)))
+    let (b, xf) = oracle::rigid2(&q);
+    (q, b, xf)
+}
+
+/// The bound bvkit documents (see [`Bound::documented`]).
+pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
+    Bound::documented(method, rounding, dims)
 }

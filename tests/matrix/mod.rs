@@ -4,14 +4,13 @@
 //! writes it to `docs/STABILITY.md`.
 #![allow(dead_code)]
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
 use bvkit::{Aabb2, Aabb3, Aabb3x8, Affine3x8, Backend, Batch, Method, Rigid2, Rounding};
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use glam::{Affine2, Affine3A, Mat2, Vec2, Vec3A};
 use rand::RngExt;
 use rand::rngs::StdRng;
 
 use super::cases::{Class, problem, rng};
-use super::oracle::{Bound, Expected, Problem, check};
+use super::oracle::{Bound, Expected, Problem, affine3, check};
 
 /// Cases per cell.
 pub const CASES: u64 = 400;
@@ -167,30 +166,6 @@ impl Cell {
     }
 }
 
-fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
-    match rounding {
-        Rounding::Nearest => Bound::Nearest {
-            gamma_n: method.nearest_gamma(dims),
-            tiny: f64::from(TINY_ERROR),
-        },
-        Rounding::Outward => Bound::Outward {
-            k: method.outward_pad(dims),
-            tiny: f64::from(TINY_PAD),
-        },
-    }
-}
-
-fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
-    let [x, y, z] = p.cols.map(Vec3A::from_array);
-    (
-        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
-        Affine3A {
-            matrix3: Mat3A::from_cols(x, y, z),
-            translation: Vec3A::from_array(p.t),
-        },
-    )
-}
-
 /// The 2D problem on the first two axes of a 3D one.
 fn planar(p: &Problem<3>) -> Problem<2> {
     Problem {
@@ -242,7 +217,10 @@ pub fn compute() -> Vec<Vec<Vec<Cell>>> {
             .map(|p| Rigid2::new(p.cols[0][0], p.cols[0][1], p.t.into()))
             .collect();
         for (ki, &(method, rounding)) in kernels.iter().enumerate() {
-            let (b3, b2) = (bound(method, rounding, 3), bound(method, rounding, 2));
+            let (b3, b2) = (
+                Bound::documented(method, rounding, 3),
+                Bound::documented(method, rounding, 2),
+            );
             for (k, p) in ps.iter().enumerate() {
                 let (b, xf) = (local[k], xfs[k]);
                 let o = b.transformed(&xf, method, rounding);

@@ -7,6 +7,9 @@
 //! for reporting against a bound.
 #![allow(dead_code, clippy::needless_range_loop)]
 
+use bvkit::method::{TINY_ERROR, TINY_PAD};
+use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
+use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
 
@@ -221,6 +224,20 @@ pub enum Bound {
 }
 
 impl Bound {
+    /// The bound bvkit documents for `method` and `rounding` in `dims` dimensions.
+    pub fn documented(method: Method, rounding: Rounding, dims: u32) -> Bound {
+        match rounding {
+            Rounding::Nearest => Bound::Nearest {
+                gamma_n: method.nearest_gamma(dims),
+                tiny: f64::from(TINY_ERROR),
+            },
+            Rounding::Outward => Bound::Outward {
+                k: method.outward_pad(dims),
+                tiny: f64::from(TINY_PAD),
+            },
+        }
+    }
+
     fn allowance(&self, magnitude: f64) -> f64 {
         match *self {
             Bound::Nearest { gamma_n, tiny } => gamma(gamma_n) * magnitude + tiny,
@@ -472,4 +489,37 @@ impl Exact {
         };
         Exact::face_le_ratio(-face, &negated, w)
     }
+}
+
+/// A 3D problem as bvkit's inputs.
+pub fn affine3(p: &Problem<3>) -> (Aabb3, Affine3A) {
+    let [x, y, z] = p.cols.map(Vec3A::from_array);
+    let xf = Affine3A {
+        matrix3: Mat3A::from_cols(x, y, z),
+        translation: Vec3A::from_array(p.t),
+    };
+    (
+        Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi)),
+        xf,
+    )
+}
+
+/// A 2D problem as bvkit's inputs.
+pub fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
+    let [x, y] = p.cols.map(Vec2::from_array);
+    let xf = Affine2::from_mat2_translation(Mat2::from_cols(x, y), Vec2::from_array(p.t));
+    (
+        Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
+        xf,
+    )
+}
+
+/// A 2D problem as a rigid transform `(cos, sin)` taken from its first column; the
+/// problem's matrix must be `[[c, -s], [s, c]]` for the oracle to judge it.
+pub fn rigid2(p: &Problem<2>) -> (Aabb2, Rigid2) {
+    let b = Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi));
+    (
+        b,
+        Rigid2::new(p.cols[0][0], p.cols[0][1], Vec2::from_array(p.t)),
+    )
 }
