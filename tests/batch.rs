@@ -36,18 +36,27 @@ fn problems<const N: usize>(
 }
 
 /// Same faces: equal values (min/max may pick either zero of `max(+0, -0)`), NaN as NaN.
-fn same(a: [f32; 6], b: [f32; 6]) -> bool {
+fn same(a: &[f32], b: &[f32]) -> bool {
     a.iter()
-        .zip(&b)
+        .zip(b)
         .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
 }
 
-fn flat3(b: &Aabb3) -> [f32; 6] {
-    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z]
+/// A box as its faces, so that one checker serves 3D and 2D.
+trait Faces<const N: usize>: core::fmt::Debug {
+    fn faces(&self) -> ([f32; N], [f32; N]);
 }
 
-fn flat2(b: &Aabb2) -> [f32; 6] {
-    [b.min.x, b.min.y, b.max.x, b.max.y, 0.0, 0.0]
+impl Faces<3> for Aabb3 {
+    fn faces(&self) -> ([f32; 3], [f32; 3]) {
+        (self.min.to_array(), self.max.to_array())
+    }
+}
+
+impl Faces<2> for Aabb2 {
+    fn faces(&self) -> ([f32; 2], [f32; 2]) {
+        (self.min.to_array(), self.max.to_array())
+    }
 }
 
 /// Backends whose arithmetic is the scalar reference's, rounding for rounding (no FMA).
@@ -56,54 +65,27 @@ fn bitwise_like_scalar(b: Backend) -> bool {
         || (b == Backend::Wide && !cfg!(target_feature = "fma"))
 }
 
-fn check3(
+/// Every box of `out` against the oracle, and against the scalar `reference` when the
+/// backend rounds as the scalar path does.
+fn check_boxes<const N: usize, B: Faces<N>>(
     name: &str,
-    ps: &[Problem<3>],
-    out: &[Aabb3],
-    reference: &[Aabb3],
+    ps: &[Problem<N>],
+    out: &[B],
+    reference: &[B],
     bitwise: bool,
     method: Method,
     rounding: Rounding,
 ) {
     assert_eq!(out.len(), ps.len(), "{name}");
+    let bound = Bound::documented(method, rounding, N as u32);
     for (k, (p, o)) in ps.iter().zip(out).enumerate() {
-        if let Err(e) = check(
-            p,
-            o.min.to_array(),
-            o.max.to_array(),
-            Bound::documented(method, rounding, 3),
-        ) {
+        let (min, max) = o.faces();
+        if let Err(e) = check(p, min, max, bound) {
             panic!("{name} box {k}: {e}\n{p:?}");
         }
+        let (rmin, rmax) = reference[k].faces();
         assert!(
-            !bitwise || same(flat3(o), flat3(&reference[k])),
-            "{name} box {k}: {o:?} != scalar {:?}",
-            reference[k]
-        );
-    }
-}
-
-fn check2(
-    name: &str,
-    ps: &[Problem<2>],
-    out: &[Aabb2],
-    reference: &[Aabb2],
-    bitwise: bool,
-    method: Method,
-    rounding: Rounding,
-) {
-    assert_eq!(out.len(), ps.len(), "{name}");
-    for (k, (p, o)) in ps.iter().zip(out).enumerate() {
-        if let Err(e) = check(
-            p,
-            o.min.to_array(),
-            o.max.to_array(),
-            Bound::documented(method, rounding, 2),
-        ) {
-            panic!("{name} box {k}: {e}\n{p:?}");
-        }
-        assert!(
-            !bitwise || same(flat2(o), flat2(&reference[k])),
+            !bitwise || (same(&min, &rmin) && same(&max, &rmax)),
             "{name} box {k}: {o:?} != scalar {:?}",
             reference[k]
         );
@@ -151,7 +133,7 @@ fn every_3d_layout_on_every_backend() {
 
                     let mut out = vec![Aabb3::NAN; len];
                     batch.aos(&local, &xfs, &mut out).unwrap();
-                    check3(
+                    check_boxes(
                         &name("aos"),
                         &ps,
                         &out,
@@ -162,7 +144,7 @@ fn every_3d_layout_on_every_backend() {
                     );
                     if !ps.is_empty() {
                         batch.aos_shared(&local, &shared, &mut out).unwrap();
-                        check3(
+                        check_boxes(
                             &name("aos shared"),
                             &shared_ps,
                             &out,
@@ -176,7 +158,7 @@ fn every_3d_layout_on_every_backend() {
                     let (local8, xfs8) = (Aabb3x8::pack(&local), Affine3x8::pack(&xfs));
                     let mut out8 = vec![Aabb3x8::EMPTY; local8.len()];
                     batch.aosoa(&local8, &xfs8, &mut out8).unwrap();
-                    check3(
+                    check_boxes(
                         &name("aosoa"),
                         &ps,
                         &Aabb3x8::unpack(&out8, len),
@@ -193,7 +175,7 @@ fn every_3d_layout_on_every_backend() {
                     );
                     if !ps.is_empty() {
                         batch.aosoa_shared(&local8, &shared, &mut out8).unwrap();
-                        check3(
+                        check_boxes(
                             &name("aosoa shared"),
                             &shared_ps,
                             &Aabb3x8::unpack(&out8, len),
@@ -210,7 +192,7 @@ fn every_3d_layout_on_every_backend() {
                         .soa(soa.view(), xsoa.view(), out_soa.view_mut())
                         .unwrap();
                     let got: Vec<Aabb3> = (0..len).map(|k| out_soa.get(k)).collect();
-                    check3(
+                    check_boxes(
                         &name("soa"),
                         &ps,
                         &got,
@@ -224,7 +206,7 @@ fn every_3d_layout_on_every_backend() {
                             .soa_shared(soa.view(), &shared, out_soa.view_mut())
                             .unwrap();
                         let got: Vec<Aabb3> = (0..len).map(|k| out_soa.get(k)).collect();
-                        check3(
+                        check_boxes(
                             &name("soa shared"),
                             &shared_ps,
                             &got,
@@ -237,7 +219,7 @@ fn every_3d_layout_on_every_backend() {
                 }
                 let mut out = vec![Aabb3::NAN; len];
                 transform_slice(&local, &xfs, &mut out, method, rounding).unwrap();
-                check3(
+                check_boxes(
                     "transform_slice",
                     &ps,
                     &out,
@@ -288,7 +270,7 @@ fn every_2d_layout_on_every_backend() {
                     };
                     let mut out = vec![Aabb2::NAN; len];
                     batch.aos2(&local, &xfs, &mut out).unwrap();
-                    check2(
+                    check_boxes(
                         &name("aos2"),
                         &ps,
                         &out,
@@ -298,7 +280,7 @@ fn every_2d_layout_on_every_backend() {
                         rounding,
                     );
                     batch.aos_rigid2(&rlocal, &rigid, &mut out).unwrap();
-                    check2(
+                    check_boxes(
                         &name("rigid2"),
                         &rps,
                         &out,
@@ -321,7 +303,7 @@ fn every_2d_layout_on_every_backend() {
                             .map(|b| b.transformed(x, method, rounding))
                             .collect();
                         batch.aos2_shared(&local, x, &mut out).unwrap();
-                        check2(
+                        check_boxes(
                             &name("aos2 shared"),
                             &sp,
                             &out,
@@ -343,7 +325,7 @@ fn every_2d_layout_on_every_backend() {
                             .map(|b| b.transformed_rigid(r, method, rounding))
                             .collect();
                         batch.aos_rigid2_shared(&rlocal, r, &mut out).unwrap();
-                        check2(
+                        check_boxes(
                             &name("rigid2 shared"),
                             &srp,
                             &out,
