@@ -31,10 +31,10 @@ fn bench(c: &mut Criterion) {
     for (n, size) in SIZES {
         let (boxes, xfs, poses) = scene(n, 0x5eed);
         let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));
-        let (bs, xs) = (AabbSoa::from_boxes(&boxes), Affine3Soa::from_affines(&xfs));
+        let (bs, xs) = (AabbSoa::from_slice(&boxes), Affine3Soa::from_slice(&xfs));
         let (pb, pp) = parry_scene(&boxes, &poses);
-        let mut o8 = vec![Aabb3x8::EMPTY; b8.len()];
-        let mut os = AabbSoa::empty(n);
+        let mut o8 = vec![Aabb3x8::default(); b8.len()];
+        let mut os = AabbSoa::filled(n, Aabb3::EMPTY);
         let mut oa = vec![Aabb3::EMPTY; n];
         let mut op = pb.clone();
 
@@ -78,7 +78,7 @@ fn bench(c: &mut Criterion) {
                     |b| {
                         b.iter(|| {
                             batch
-                                .aosoa(black_box(&b8), black_box(&x8), &mut o8)
+                                .transform(black_box(&b8), black_box(&x8), &mut o8)
                                 .unwrap()
                         })
                     },
@@ -91,7 +91,11 @@ fn bench(c: &mut Criterion) {
                     |b| {
                         b.iter(|| {
                             batch
-                                .soa(black_box(bs.view()), black_box(xs.view()), os.view_mut())
+                                .transform(
+                                    black_box(bs.view()),
+                                    black_box(xs.view()),
+                                    os.view_mut(),
+                                )
                                 .unwrap()
                         })
                     },
@@ -101,7 +105,7 @@ fn bench(c: &mut Criterion) {
                     |b| {
                         b.iter(|| {
                             batch
-                                .aos(black_box(&boxes), black_box(&xfs), &mut oa)
+                                .transform(black_box(&boxes), black_box(&xfs), &mut oa)
                                 .unwrap()
                         })
                     },
@@ -118,7 +122,7 @@ fn bench(c: &mut Criterion) {
                 |b| {
                     b.iter(|| {
                         batch
-                            .aosoa(black_box(&b8), black_box(&x8), &mut o8)
+                            .transform(black_box(&b8), black_box(&x8), &mut o8)
                             .unwrap()
                     })
                 },

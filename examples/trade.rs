@@ -27,12 +27,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use bvkit::{
-    Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rigid2, Rounding,
+    Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Block8, Method, Rigid2,
+    Rounding, Transform2, Transform3, Translation2, Translation3,
 };
-use glam::{Affine2, Affine3A, Vec2};
+use glam::{Affine2, Affine3A, Vec2, Vec3A};
 
-use cases::{Class, problem, rigid_problem, rng};
-use oracle::{Bound, Problem, affine2, affine3, check, rigid2};
+use cases::{Class, Scale, problem, quat_problem, rigid_problem, rng, translation_problem};
+use oracle::{Bound, Exactly, Problem, QuatProblem, affine2, affine3, check, rigid2};
 
 /// The seed of every random sample: the accuracy columns are identical run to run.
 const SEED: u64 = 0xb0c5_2026;
@@ -114,8 +115,8 @@ fn sample<const N: usize>(
 
 /// Checks `results` against the oracle (panics on a broken contract: the report must not
 /// print figures of a kernel that is wrong) and summarises.
-fn accuracy<const N: usize>(
-    sample: &[(Class, Problem<N>)],
+fn accuracy<const N: usize, P: Exactly<N>>(
+    sample: &[(Class, P)],
     results: &[([f32; N], [f32; N])],
     bound: Bound,
 ) -> Accuracy {
@@ -155,10 +156,10 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
     let mut rows = Vec::new();
     let (boxes, xfs, poses) = common::scene(DRAM, 0x3d);
     let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));
-    let (bs, xs) = (AabbSoa::from_boxes(&boxes), Affine3Soa::from_affines(&xfs));
+    let (bs, xs) = (AabbSoa::from_slice(&boxes), Affine3Soa::from_slice(&xfs));
     let mut out = vec![Aabb3::EMPTY; DRAM];
-    let mut o8 = vec![Aabb3x8::EMPTY; b8.len()];
-    let mut os = AabbSoa::empty(DRAM);
+    let mut o8 = vec![Aabb3x8::default(); b8.len()];
+    let mut os = AabbSoa::filled(DRAM, Aabb3::EMPTY);
     let sample = sample::<3>(problem);
     let (sb, sx): (Vec<Aabb3>, Vec<Affine3A>) = sample.iter().map(|(_, p)| affine3(p)).unzip();
     let row = |kernel: String,
@@ -249,15 +250,9 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
         None,
     ));
     let small = |n: usize| {
-        let b = AabbSoa {
-            min: bs.min.clone().map(|c| c[..n].to_vec()),
-            max: bs.max.clone().map(|c| c[..n].to_vec()),
-        };
-        let x = Affine3Soa {
-            cols: xs.cols.clone().map(|c| c.map(|v| v[..n].to_vec())),
-            translation: xs.translation.clone().map(|c| c[..n].to_vec()),
-        };
-        (b, x, AabbSoa::empty(n))
+        let b = AabbSoa::from_columns(bs.columns.clone().map(|c| c[..n].to_vec()));
+        let x = Affine3Soa::from_columns(xs.columns.clone().map(|c| c[..n].to_vec()));
+        (b, x, AabbSoa::filled(n, Aabb3::EMPTY))
     };
     let (cb, cx, mut co) = small(CACHE);
     let t = (
@@ -348,10 +343,10 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
                 let mut o = vec![Aabb3::EMPTY; sb.len()];
                 let t = times(|n| {
                     batch
-                        .aos(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+                        .transform(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
                         .unwrap()
                 });
-                batch.aos(&sb, &sx, &mut o).unwrap();
+                batch.transform(&sb, &sx, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat3).collect();
                 rows.push(row(
                     kernel.clone(),
@@ -367,18 +362,20 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
                 let t = (
                     ns_per_box(CACHE, 301, || {
                         batch
-                            .soa(black_box(cb.view()), cx.view(), co.view_mut())
+                            .transform(black_box(cb.view()), cx.view(), co.view_mut())
                             .unwrap()
                     }),
                     ns_per_box(DRAM, 5, || {
                         batch
-                            .soa(black_box(bs.view()), xs.view(), os.view_mut())
+                            .transform(black_box(bs.view()), xs.view(), os.view_mut())
                             .unwrap()
                     }),
                 );
-                let (ssb, ssx) = (AabbSoa::from_boxes(&sb), Affine3Soa::from_affines(&sx));
-                let mut sso = AabbSoa::empty(sb.len());
-                batch.soa(ssb.view(), ssx.view(), sso.view_mut()).unwrap();
+                let (ssb, ssx) = (AabbSoa::from_slice(&sb), Affine3Soa::from_slice(&sx));
+                let mut sso = AabbSoa::filled(sb.len(), Aabb3::EMPTY);
+                batch
+                    .transform(ssb.view(), ssx.view(), sso.view_mut())
+                    .unwrap();
                 let results: Vec<_> = (0..sb.len()).map(|k| flat3(&sso.get(k))).collect();
                 rows.push(row(
                     kernel.clone(),
@@ -392,7 +389,7 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
 
                 let t = times(|n| {
                     batch
-                        .aosoa(
+                        .transform(
                             black_box(&b8[..n / 8]),
                             black_box(&x8[..n / 8]),
                             &mut o8[..n / 8],
@@ -400,8 +397,8 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
                         .unwrap()
                 });
                 let (s8, x8s) = (Aabb3x8::pack(&sb), Affine3x8::pack(&sx));
-                let mut so8 = vec![Aabb3x8::EMPTY; s8.len()];
-                batch.aosoa(&s8, &x8s, &mut so8).unwrap();
+                let mut so8 = vec![Aabb3x8::default(); s8.len()];
+                batch.transform(&s8, &x8s, &mut so8).unwrap();
                 let results: Vec<_> = Aabb3x8::unpack(&so8, sb.len()).iter().map(flat3).collect();
                 rows.push(row(
                     kernel.clone(),
@@ -431,6 +428,13 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
         .map(|(q, t)| Rigid2::from_angle_translation(q.to_axis_angle().1, Vec2::new(t.x, t.y)))
         .collect();
     let affine: Vec<Affine2> = rigid.iter().map(Rigid2::to_affine2).collect();
+    let translation: Vec<Translation2> =
+        rigid.iter().map(|r| Translation2(r.translation)).collect();
+    let translation_sample = sample::<2>(translation_problem::<2>);
+    let (tb, tx): (Vec<Aabb2>, Vec<Translation2>) = translation_sample
+        .iter()
+        .map(|(_, p)| (affine2(p).0, Translation2(Vec2::from_array(p.t))))
+        .unzip();
     let mut out = vec![Aabb2::EMPTY; DRAM];
     let affine_sample = sample::<2>(problem);
     let rigid_sample = sample::<2>(rigid_problem);
@@ -509,11 +513,63 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
                 t,
                 accuracy(&affine_sample, &results, b2),
             ));
+            let bt = Bound::of_order(Translation2::nearest_gamma(method), rounding);
+            let t = times(|n| {
+                for ((b, xf), o) in black_box(&boxes[..n])
+                    .iter()
+                    .zip(&translation[..n])
+                    .zip(&mut out[..n])
+                {
+                    *o = b.transformed(xf, method, rounding);
+                }
+            });
+            let results: Vec<_> = tb
+                .iter()
+                .zip(&tx)
+                .map(|(b, x)| flat2(&b.transformed(x, method, rounding)))
+                .collect();
+            let single = accuracy(&translation_sample, &results, bt);
+            rows.push(row(
+                TRANSLATION2,
+                kernel.clone(),
+                method,
+                rounding,
+                "single",
+                "scalar",
+                t,
+                single,
+            ));
+            let batch = Batch::new(method, rounding)
+                .on(backends[0])
+                .expect("supported");
+            let t = times(|n| {
+                batch
+                    .transform(
+                        black_box(&boxes[..n]),
+                        black_box(&translation[..n]),
+                        &mut out[..n],
+                    )
+                    .unwrap()
+            });
+            let mut o = vec![Aabb2::EMPTY; tb.len()];
+            batch.transform(&tb, &tx, &mut o).unwrap();
+            let results: Vec<_> = o.iter().map(flat2).collect();
+            let acc = accuracy(&translation_sample, &results, bt);
+            rows.push(row(
+                TRANSLATION2,
+                kernel.clone(),
+                method,
+                rounding,
+                "aos",
+                backends[0].name(),
+                t,
+                acc,
+            ));
             for &backend in backends {
                 let batch = Batch::new(method, rounding).on(backend).expect("supported");
                 let t = times(|n| {
                     batch
-                        .aos_rigid2(
+                        .transform(
                             black_box(&boxes[..n]),
                             black_box(&rigid[..n]),
                             &mut out[..n],
@@ -521,7 +577,7 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
                         .unwrap()
                 });
                 let mut o = vec![Aabb2::EMPTY; rb.len()];
-                batch.aos_rigid2(&rb, &rx, &mut o).unwrap();
+                batch.transform(&rb, &rx, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat2).collect();
                 rows.push(row(
                     "2D rigid",
@@ -535,14 +591,14 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
                 ));
                 let t = times(|n| {
                     batch
-                        .aos2(
+                        .transform(
                             black_box(&boxes[..n]),
                             black_box(&affine[..n]),
                             &mut out[..n],
                         )
                         .unwrap()
                 });
-                batch.aos2(&ab, &ax, &mut o).unwrap();
+                batch.transform(&ab, &ax, &mut o).unwrap();
                 let results: Vec<_> = o.iter().map(flat2).collect();
                 rows.push(row(
                     "2D affine",
@@ -560,9 +616,274 @@ fn measure_2d(backends: &[Backend]) -> Vec<Row> {
     rows
 }
 
+const TRANSLATION3: &str = "3D translation";
+const RIGID3: &str = "3D rigid";
+const SIMILARITY3: &str = "3D similarity";
+const TRS3: &str = "3D scale-rotation-translation";
+const TRANSLATION2: &str = "2D translation";
+
+/// What the class table shows of one class: its bytes per box (AoSoA, read and written)
+/// and its roofline row's times.
+struct ClassBytes {
+    class: &'static str,
+    type_name: &'static str,
+    bytes: usize,
+}
+
+/// Every kernel of one 3D class: AoSoA and AoS on the best backend, single boxes, and the
+/// memory roofline that moves the class's bytes, with the oracle's accuracy over a sample
+/// of the class's own problems.
+#[allow(clippy::too_many_arguments)]
+fn measure_class<T: Transform3, P: Exactly<3>, const F: usize>(
+    class: &'static str,
+    best: Backend,
+    boxes: &[Aabb3],
+    xfs: &[T],
+    raw: impl Fn(&Block8<T>) -> [[f32; 8]; F],
+    sample: &[(Class, P)],
+    inputs: impl Fn(&P) -> (Aabb3, T),
+) -> Vec<Row> {
+    progress(class);
+    let mut rows = Vec::new();
+    let (b8, x8) = (Aabb3x8::pack(boxes), Block8::pack(xfs));
+    let braw: Vec<[[f32; 8]; 6]> = b8.iter().map(|b| b.fields).collect();
+    let xraw: Vec<[[f32; 8]; F]> = x8.iter().map(raw).collect();
+    let (mut oraw, mut o8) = (braw.clone(), vec![Aabb3x8::default(); b8.len()]);
+    let mut out = vec![Aabb3::EMPTY; boxes.len()];
+    let (sb, sx): (Vec<Aabb3>, Vec<T>) = sample.iter().map(|(_, p)| inputs(p)).unzip();
+    let row =
+        |kernel: String, method, rounding, layout, backend, (ns_cache, ns_dram), accuracy| Row {
+            class,
+            kernel,
+            method,
+            rounding,
+            layout,
+            backend,
+            ns_cache,
+            ns_dram,
+            accuracy,
+            ratio: 0.0,
+        };
+    let t = times(|n| {
+        common::roofline_blocks(
+            black_box(&braw[..n / 8]),
+            black_box(&xraw[..n / 8]),
+            &mut oraw[..n / 8],
+        )
+    });
+    rows.push(row(
+        "memory roofline".into(),
+        None,
+        None,
+        "aosoa",
+        "roofline",
+        t,
+        None,
+    ));
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let kernel = format!("{} {}", method.name(), rounding.name());
+            let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+            let batch = Batch::new(method, rounding).on(best).expect("detected");
+            let mut so = vec![Aabb3::EMPTY; sb.len()];
+            batch.transform(&sb, &sx, &mut so).expect("lengths");
+            let results: Vec<_> = so.iter().map(flat3).collect();
+            let batch_accuracy = Some(accuracy(sample, &results, bound));
+            let t = times(|n| {
+                batch
+                    .transform(
+                        black_box(&b8[..n / 8]),
+                        black_box(&x8[..n / 8]),
+                        &mut o8[..n / 8],
+                    )
+                    .expect("lengths")
+            });
+            let (m, r) = (Some(method), Some(rounding));
+            rows.push(row(
+                kernel.clone(),
+                m,
+                r,
+                "aosoa",
+                best.name(),
+                t,
+                batch_accuracy,
+            ));
+            let t = times(|n| {
+                batch
+                    .transform(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
+                    .expect("lengths")
+            });
+            rows.push(row(
+                kernel.clone(),
+                m,
+                r,
+                "aos",
+                best.name(),
+                t,
+                batch_accuracy,
+            ));
+            let results: Vec<_> = sb
+                .iter()
+                .zip(&sx)
+                .map(|(b, x)| flat3(&b.transformed(x, method, rounding)))
+                .collect();
+            let single_accuracy = Some(accuracy(sample, &results, bound));
+            let t = times(|n| {
+                for ((b, x), o) in boxes[..n].iter().zip(&xfs[..n]).zip(&mut out[..n]) {
+                    *o = black_box(b).transformed(x, method, rounding);
+                }
+            });
+            rows.push(row(kernel, m, r, "single", "glam simd", t, single_accuracy));
+        }
+    }
+    rows
+}
+
+/// The dedicated 3D classes on one scene, with the peers on the same poses.
+fn measure_classes(best: Backend) -> (Vec<Row>, Vec<ClassBytes>) {
+    let s = common::class_scene(DRAM, 0xc1a55);
+    let mut rows = Vec::new();
+    let quats = |scale| -> Vec<(Class, QuatProblem)> {
+        let mut out = Vec::new();
+        for class in ACCURACY_CLASSES {
+            let r = &mut rng(SEED ^ (class as u64) << 40 ^ 0x51);
+            out.extend((0..CASES).map(|_| (class, quat_problem(class, scale, r))));
+        }
+        out
+    };
+    let translations = sample::<3>(translation_problem::<3>);
+    rows.extend(measure_class(
+        TRANSLATION3,
+        best,
+        &s.boxes,
+        &s.translation,
+        |b| b.fields,
+        &translations,
+        |p| (affine3(p).0, Translation3(Vec3A::from_array(p.t))),
+    ));
+    rows.extend(measure_class(
+        RIGID3,
+        best,
+        &s.boxes,
+        &s.rigid,
+        |b| b.fields,
+        &quats(Scale::Unit),
+        |p| (p.aabb(), p.rigid3()),
+    ));
+    rows.extend(measure_class(
+        SIMILARITY3,
+        best,
+        &s.boxes,
+        &s.similarity,
+        |b| b.fields,
+        &quats(Scale::Uniform),
+        |p| (p.aabb(), p.similarity3()),
+    ));
+    rows.extend(measure_class(
+        TRS3,
+        best,
+        &s.boxes,
+        &s.trs,
+        |b| b.fields,
+        &quats(Scale::PerAxis),
+        |p| (p.aabb(), p.trs3()),
+    ));
+    // The peers, on the rigid poses of the same scene.
+    let (pb, pp) = common::parry_scene(&s.boxes, &s.poses);
+    let mut op = pb.clone();
+    let mut out = vec![Aabb3::EMPTY; DRAM];
+    let peer = |kernel: &str, t: (f64, f64)| Row {
+        class: RIGID3,
+        kernel: kernel.into(),
+        method: None,
+        rounding: None,
+        layout: "aos",
+        backend: "peer",
+        ns_cache: t.0,
+        ns_dram: t.1,
+        accuracy: None,
+        ratio: 0.0,
+    };
+    let t = times(|n| {
+        common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
+    });
+    rows.push(peer("parry3d Aabb::transform_by", t));
+    let t = times(|n| {
+        common::glam_rigid_abs_matrix(
+            black_box(&s.boxes[..n]),
+            black_box(&s.rigid[..n]),
+            &mut out[..n],
+        )
+    });
+    rows.push(peer("glam loop: Mat3A::from_quat + abs-matrix", t));
+    let bytes = [
+        (TRANSLATION3, "Translation3", 3),
+        (RIGID3, "Rigid3", 7),
+        (SIMILARITY3, "Similarity3", 8),
+        (TRS3, "Trs3", 10),
+        ("3D affine", "Affine3A", 12),
+    ]
+    .map(|(class, type_name, fields)| ClassBytes {
+        class,
+        type_name,
+        bytes: 48 + 4 * fields,
+    });
+    (rows, bytes.into())
+}
+
+/// The class table: per class, its bytes, the fastest AoSoA kernel against its roofline and
+/// against the affine class at the DRAM size.
+fn class_table(rows: &[Row], classes: &[ClassBytes], best: &str) -> String {
+    let find = |class: &str, kernel: &str, layout: &str, backend: &str| {
+        rows.iter().find(|r| {
+            r.class == class && r.kernel == kernel && r.layout == layout && r.backend == backend
+        })
+    };
+    let affine = find("3D affine", "abs-matrix nearest", "aosoa", best);
+    let mut s = String::from(
+        "| class | type | bytes/box (AoSoA) | abs-matrix nearest AoSoA ns/box cache | DRAM | roofline DRAM | × roofline (DRAM) | affine / this (DRAM) | sign-select outward AoSoA DRAM | AoS abs-matrix nearest, cache |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for c in classes {
+        let (Some(k), Some(o), Some(rl), Some(aos)) = (
+            find(c.class, "abs-matrix nearest", "aosoa", best),
+            find(c.class, "sign-select outward", "aosoa", best),
+            find(c.class, "memory roofline", "aosoa", "roofline"),
+            find(c.class, "abs-matrix nearest", "aos", best),
+        ) else {
+            continue;
+        };
+        let vs_affine = affine.map_or(String::new(), |a| format!("{:.2}x", a.ns_dram / k.ns_dram));
+        writeln!(
+            s,
+            "| {} | `{}` | {} | {:.2} | {:.2} | {:.2} | {:.2}x | {} | {:.2} | {:.2} |",
+            c.class,
+            c.type_name,
+            c.bytes,
+            k.ns_cache,
+            k.ns_dram,
+            rl.ns_dram,
+            k.ns_dram / rl.ns_dram,
+            vs_affine,
+            o.ns_dram,
+            aos.ns_cache
+        )
+        .unwrap();
+    }
+    s
+}
+
 /// Each row's in-cache time over the fastest kernel of its transform class.
 fn set_ratios(rows: &mut [Row]) {
-    for class in ["3D affine", "2D affine", "2D rigid"] {
+    for class in [
+        "3D affine",
+        "2D affine",
+        "2D rigid",
+        TRANSLATION3,
+        RIGID3,
+        SIMILARITY3,
+        TRS3,
+        TRANSLATION2,
+    ] {
         let fastest = rows
             .iter()
             .filter(|r| r.class == class && r.method.is_some())
@@ -640,10 +961,13 @@ fn csv(rows: &[Row]) -> String {
 /// may miss by a few ulps, from the measured rows (in cache, where compute decides).
 fn recommendations(rows: &[Row]) -> String {
     let profiles = [
+        ("2D sprites, moved only", TRANSLATION2),
         ("2D sprites (rotation + translation)", "2D rigid"),
         ("2D sprites with scale or shear", "2D affine"),
-        ("rigid bodies (3D)", "3D affine"),
-        ("scaled props (3D)", "3D affine"),
+        ("spheres, particles (3D translation only)", TRANSLATION3),
+        ("rigid bodies (3D, quaternion + position)", RIGID3),
+        ("uniformly scaled props (3D)", SIMILARITY3),
+        ("scaled props (3D, bevy Transform)", TRS3),
         ("sheared / skinned (3D)", "3D affine"),
     ];
     let mut s = String::from(
@@ -678,7 +1002,7 @@ fn recommendations(rows: &[Row]) -> String {
         }));
         writeln!(s, "| {profile} | {must} | {ulps} |").unwrap();
     }
-    s.push_str("\nThe 3D profiles share the affine kernels: bvkit has no dedicated 3D rigid or scale-only kernel yet, so they get the same figures; the sample covers rotations, reflections, scale, shear and drift alike.\n");
+    s.push_str("\nEach profile uses its dedicated transform class (the class's own kernel and its own bytes per box); the accuracy is against the exact image of that class's map, in units of its own `u·S` (see `bvkit::transform`).\n");
     s
 }
 
@@ -816,6 +1140,8 @@ fn main() -> std::io::Result<()> {
         CASES * ACCURACY_CLASSES.len() as u64
     );
     let mut rows = measure_3d(&backends);
+    let (class_rows, class_bytes) = measure_classes(best);
+    rows.extend(class_rows);
     rows.extend(measure_2d(&backends));
     set_ratios(&mut rows);
 
@@ -826,6 +1152,11 @@ fn main() -> std::io::Result<()> {
         ACCURACY_CLASSES
     );
     println!("{}", table(&rows));
+    println!("## Transform classes: bytes, rooflines and the affine class\n");
+    println!(
+        "Every class on the same {DRAM} boxes (and poses that differ only in what each class holds), on the best backend. The roofline moves the class's bytes with one addition per float.\n"
+    );
+    println!("{}", class_table(&rows, &class_bytes, best.name()));
     println!("## Recommendations\n");
     println!("{}", recommendations(&rows));
     let key = |class: &str, kernel: &str, layout: &str, backend: &str| {
@@ -862,6 +1193,41 @@ fn main() -> std::io::Result<()> {
         println!(
             "| abs-matrix nearest AoSoA / memory roofline, DRAM | {:.2}x | <= 1.15x |",
             n.ns_dram / rl.ns_dram
+        );
+        println!();
+    }
+    if let (
+        Some(rigid),
+        Some(affine),
+        Some(translation),
+        Some(rigid_roof),
+        Some(rigid_aos),
+        Some(parry),
+    ) = (
+        key(RIGID3, "abs-matrix nearest", "aosoa", b),
+        key("3D affine", "abs-matrix nearest", "aosoa", b),
+        key(TRANSLATION3, "abs-matrix nearest", "aosoa", b),
+        key(RIGID3, "memory roofline", "aosoa", "roofline"),
+        key(RIGID3, "abs-matrix nearest", "aos", b),
+        key(RIGID3, "parry3d Aabb::transform_by", "aos", "peer"),
+    ) {
+        println!("## Transform-class targets, measured in this run\n");
+        println!("| figure | measured | target |\n|---|---:|---:|");
+        println!(
+            "| affine AoSoA / rigid AoSoA, 4M boxes | {:.2}x | >= 1.25x |",
+            affine.ns_dram / rigid.ns_dram
+        );
+        println!(
+            "| rigid AoSoA / its roofline, 4M boxes | {:.2}x | <= 1.15x |",
+            rigid.ns_dram / rigid_roof.ns_dram
+        );
+        println!(
+            "| affine AoSoA / translation AoSoA, 4M boxes | {:.2}x | >= 1.6x |",
+            affine.ns_dram / translation.ns_dram
+        );
+        println!(
+            "| parry3d loop / rigid AoS (`&[Rigid3]`), in cache | {:.2}x | >= 8x |",
+            parry.ns_cache / rigid_aos.ns_cache
         );
         println!();
     }

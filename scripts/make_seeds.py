@@ -50,8 +50,33 @@ classes3 = {
     "nan": (rot3(0.2), [NAN, 0.0, 0.0], [0.0] * 3, [1.0] * 3),
 }
 
+H = math.sqrt(0.5)
+UNIT = [0.1, 0.2, 0.3, math.sqrt(1 - 0.14)]
+# Per extreme class: a quaternion [x, y, z, w] and a per-axis scale.
+QUATS = {
+    "far_1e3": (UNIT, [1.0] * 3),
+    "far_1e5": (UNIT, [2.0] * 3),
+    "far_1e7": (UNIT, [1.0, 2.0, 3.0]),
+    "far_1e9": (UNIT, [1.0] * 3),
+    "near_max": ([1e19, 2e18, 0.0, 1.0], [1e38, 1.0, 2.0]),
+    "overflow": ([0.0, 0.0, 0.0, 1.0], [3e38] * 3),
+    "subnormal": ([TINY, 0.0, TINY, 1.0], [TINY, 1.0, 1e30]),
+    "zero_size": (UNIT, [1.0] * 3),
+    "signed_zero": ([-0.0, 0.0, -0.0, 1.0], [-0.0, 0.0, 1.0]),
+    "quarter_turn": ([0.0, 0.0, H, H], [1.0] * 3),
+    "drifted": ([x * 1.001 for x in UNIT], [1.0] * 3),
+    "reflection": (UNIT, [-1.0, 1.0, -2.0]),
+    "near_singular": ([0.0] * 4, [0.0, 1e-30, 1e30]),
+    "shear": ([3.0, -2.0, 5.0, 0.5], [1.0] * 3),
+    "unbounded": ([0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 2.0]),
+    "empty": (UNIT, [1.0] * 3),
+    "nan": ([NAN, 0.0, 0.0, 1.0], [1.0] * 3),
+}
+
 root = pathlib.Path("fuzz/seeds")
-for target in ["affine3", "affine2", "rigid2", "mat4", "batch"]:
+TARGETS = ["affine3", "affine2", "rigid2", "mat4", "batch", "translation3", "translation2",
+           "rigid3", "similarity3", "trs3"]
+for target in TARGETS:
     (root / target).mkdir(parents=True, exist_ok=True)
 
 for name, (cols, t, lo, hi) in classes3.items():
@@ -62,8 +87,20 @@ for name, (cols, t, lo, hi) in classes3.items():
     data2 = problem2(cols2, t[:2], lo[:2], hi[:2], order)
     (root / "affine2" / name).write_bytes(data2)
     (root / "rigid2" / name).write_bytes(data2)
-    # batch: backend, method, rounding bytes, n, then n 3D and n 2D problems.
-    (root / "batch" / name).write_bytes(bytes([0, 1, 1, 9]) + data3 * 9 + data2 * 9)
+    # Translations read a whole problem and keep its translation and box.
+    (root / "translation3" / name).write_bytes(data3)
+    (root / "translation2" / name).write_bytes(data2)
+    # Quaternion classes: the problem, then the quaternion, then the scale (1 or 3 floats).
+    q, scale = QUATS[name]
+    quat = b"".join(map(f, q))
+    (root / "rigid3" / name).write_bytes(data3 + quat)
+    (root / "similarity3" / name).write_bytes(data3 + quat + f(scale[0]))
+    (root / "trs3" / name).write_bytes(data3 + quat + b"".join(map(f, scale)))
+    # batch: backend, method, rounding, class, n bytes, then n problems of the class
+    # (0 affine, 2 rigid3, 5 affine 2D).
+    (root / "batch" / name).write_bytes(bytes([0, 1, 1, 0, 9]) + data3 * 9)
+    (root / "batch" / (name + "_rigid3")).write_bytes(bytes([1, 2, 1, 2, 9]) + (data3 + quat) * 9)
+    (root / "batch" / (name + "_2d")).write_bytes(bytes([2, 0, 0, 5, 9]) + data2 * 9)
 
 # mat4: 16 column-major entries, the "make affine" byte, then the box.
 def mat4(cols, lo, hi, make_affine):

@@ -8,6 +8,8 @@
 
 use glam::{Vec2, Vec3A};
 
+use crate::transform::{Fields, MAX_FIELDS};
+
 /// An axis-aligned box in 3D, `min <= p <= max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb3 {
@@ -171,3 +173,48 @@ impl Aabb2 {
         core::array::from_fn(|k| Vec2::new(pick(k, 0).x, pick(k, 1).y))
     }
 }
+
+/// Fields `[min.x, min.y, min.z, max.x, max.y, max.z]`; blocks pad with `EMPTY`.
+impl Fields for Aabb3 {
+    const FIELDS: usize = 6;
+    type Array<C> = [C; 6];
+    #[inline(always)]
+    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+        core::array::from_fn(f)
+    }
+    const PADDING: Self = Self::EMPTY;
+    #[inline(always)]
+    fn to_fields(&self) -> [f32; MAX_FIELDS] {
+        let (a, b) = (self.min, self.max);
+        [a.x, a.y, a.z, b.x, b.y, b.z, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    }
+    #[inline(always)]
+    fn from_fields(f: &[f32; MAX_FIELDS]) -> Self {
+        Self::new(Vec3A::new(f[0], f[1], f[2]), Vec3A::new(f[3], f[4], f[5]))
+    }
+}
+
+/// Fields `[min.x, min.y, max.x, max.y]`; blocks pad with `EMPTY`.
+impl Fields for Aabb2 {
+    const FIELDS: usize = 4;
+    type Array<C> = [C; 4];
+    #[inline(always)]
+    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+        core::array::from_fn(f)
+    }
+    const PADDING: Self = Self::EMPTY;
+    #[inline(always)]
+    fn to_fields(&self) -> [f32; MAX_FIELDS] {
+        let (a, b) = (self.min, self.max);
+        [a.x, a.y, b.x, b.y, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    }
+    #[inline(always)]
+    fn from_fields(f: &[f32; MAX_FIELDS]) -> Self {
+        Self::new(Vec2::new(f[0], f[1]), Vec2::new(f[2], f[3]))
+    }
+}
+
+/// A box type of `N` dimensions: its fields are `min` then `max`.
+pub(crate) trait Boxes<const N: usize>: Fields {}
+impl Boxes<3> for Aabb3 {}
+impl Boxes<2> for Aabb2 {}

@@ -6,12 +6,13 @@
 //! Everything outside that domain (empty, unbounded or NaN boxes, overflow, non-finite
 //! matrices) is answered by [`crate::extended`].
 
-use crate::lane::{Axes, Lane, Vector};
+use crate::lane::{Axes, Lane};
 use crate::method::{Method, TINY_PAD, UNIT_ROUNDOFF};
+use crate::transform::MapKernel;
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct AffineLanes<V, const N: usize> {
+pub struct AffineLanes<V, const N: usize> {
     pub cols: [V; N],
     pub t: V,
 }
@@ -144,8 +145,23 @@ pub(crate) fn outward_pad<V: Axes, const N: usize>(
     s.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(TINY_PAD))
 }
 
-/// One box through one method, padded outward when asked: the fast path of every entry
-/// point. The caller checks the input box is non-empty and the result finite.
+/// One box through one method, round to nearest.
+#[inline(always)]
+pub(crate) fn bound<V: Axes, const N: usize>(
+    a: &AffineLanes<V, N>,
+    lo: V,
+    hi: V,
+    method: Method,
+) -> (V, V) {
+    match method {
+        Method::Naive => naive(a, lo, hi),
+        Method::AbsMatrix => abs_matrix(a, lo, hi),
+        Method::SignSelect => sign_select(a, lo, hi),
+    }
+}
+
+/// One box through one method, padded outward when asked: the fast path of every affine
+/// entry point. The caller checks the input box is non-empty and the result finite.
 #[inline(always)]
 pub(crate) fn transform<V: Axes, const N: usize>(
     a: &AffineLanes<V, N>,
@@ -154,11 +170,7 @@ pub(crate) fn transform<V: Axes, const N: usize>(
     method: Method,
     outward: bool,
 ) -> (V, V) {
-    let (min, max) = match method {
-        Method::Naive => naive(a, lo, hi),
-        Method::AbsMatrix => abs_matrix(a, lo, hi),
-        Method::SignSelect => sign_select(a, lo, hi),
-    };
+    let (min, max) = bound(a, lo, hi, method);
     if outward {
         let pad = outward_pad(a, lo, hi, method.outward_pad(N as u32));
         (min - pad, max + pad)
@@ -167,32 +179,105 @@ pub(crate) fn transform<V: Axes, const N: usize>(
     }
 }
 
-/// One box through a rigid 2D transform `[[cos, −sin], [sin, cos]]`, `t`:
-/// [`Method::SignSelect`] is Eberly's [`sign_branch_rigid2`], the others run as for any
-/// affine map. Same contract as [`transform`].
+impl<V: Axes, const N: usize> MapKernel<V> for AffineLanes<V, N> {
+    #[inline(always)]
+    fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V) {
+        transform(self, lo, hi, method, outward)
+    }
+}
+
+/// A translation: `[lo + t, hi + t]`, every method being the same map.
+///
+/// Nearest rounds each face once: error at most `u·|face| <= γ(1)·S`. Outward steps a face
+/// one ulp outward only where its sum was inexact, so that it is the exact face rounded
+/// outward. Knuth's TwoSum gives the error `e` with `face + e = lo + t` exactly (no
+/// overflow: the caller checks the result finite); `e < 0` means the rounded lower face
+/// lies above the exact one and must step down, `e > 0` the mirror for the upper face.
 #[inline(always)]
-pub(crate) fn transform_rigid2<L: Lane>(
-    cos: L,
-    sin: L,
-    t: [L; 2],
-    lo: [L; 2],
-    hi: [L; 2],
-    method: Method,
-    outward: bool,
-) -> ([L; 2], [L; 2]) {
-    let a = AffineLanes {
-        cols: [Vector([cos, sin]), Vector([-sin, cos])],
-        t: Vector(t),
-    };
-    if method != Method::SignSelect {
-        let (min, max) = transform(&a, Vector(lo), Vector(hi), method, outward);
-        return (min.0, max.0);
+pub(crate) fn translate<V: Lane>(t: V, lo: V, hi: V, outward: bool) -> (V, V) {
+    let (min, max) = (lo + t, hi + t);
+    if !outward {
+        return (min, max);
     }
-    let (min, max) = sign_branch_rigid2(cos, sin, t, lo, hi);
-    if outward {
-        let pad = outward_pad(&a, Vector(lo), Vector(hi), method.outward_pad(2));
-        ((Vector(min) - pad).0, (Vector(max) + pad).0)
-    } else {
-        (min, max)
-    }
+    let (e_min, e_max) = (two_sum_error(lo, t, min), two_sum_error(hi, t, max));
+    (
+        e_min.select_nonneg(min, step_down(min)),
+        (-e_max).select_nonneg(max, -step_down(-max)),
+    )
+}
+
+/// Knuth's TwoSum: the exact error `a + b − s` of `s = fl(a + b)`, six additions, valid in
+/// any rounding to nearest without overflow.
+#[inline(always)]
+fn two_sum_error<V: Lane>(a: V, b: V, s: V) -> V {
+    let b_virtual = s - a;
+    let a_virtual = s - b_virtual;
+    (a - a_virtual) + (b - b_virtual)
+}
+
+/// The next `f32` below `x` (finite `x`), in float arithmetic: `x − (|x|·c + 2^-149)` with
+/// `c = 2^-24·(1 + 2^-23)`.
+///
+/// For `x = ±m·2^k`, `m ∈ [1, 2)`, the ulp is `2^(k−23)` and `|x|·c` rounds to a value in
+/// `(ulp/2, ulp·(1 + 2^-23)]`: more than half an ulp, so round to nearest moves `x` down
+/// (to `x − ulp/2` when `x = 2^k > 0`, where the spacing below halves), and less than one
+/// and a half, so it moves by one step. Below the normal range the `2^-149` is one step.
+#[inline(always)]
+fn step_down<V: Lane>(x: V) -> V {
+    const C: f32 = UNIT_ROUNDOFF * (1.0 + f32::EPSILON);
+    x - x.abs().mul_add(V::splat(C), V::splat(f32::from_bits(1)))
+}
+
+/// The standard rotation matrix of a quaternion `[x, y, z, w]`, as glam's `Mat3::from_quat`
+/// writes it, with no normalisation: columns `(1 − (yy + zz), xy + wz, xz − wy)`,
+/// `(xy − wz, 1 − (xx + zz), yz + wx)`, `(xz + wy, yz − wx, 1 − (xx + yy))` with
+/// `xy = x·2y` and so on; and `ρ = 1 + 2‖q‖²`, which bounds every `|R_ij|` (for the
+/// diagonal `|1 − 2(y² + z²)| <= 1 + 2‖q‖²`; off it `2|xy| + 2|wz| <= ‖q‖²`).
+///
+/// Error: the doublings are exact, each product rounds once, and each entry is a sum of two
+/// products (then one more rounding with the `1`): every computed entry is within
+/// `γ(3)·ρ` of the exact one. An underflowing product errs by at most `2^-150` absolutely,
+/// which is below `2^-126·u·ρ` since `ρ >= 1`. Plain multiplications and additions, never
+/// fused: every backend forms the same `R`.
+#[inline(always)]
+pub(crate) fn rotation<L: Lane>([x, y, z, w]: [L; 4]) -> ([[L; 3]; 3], L) {
+    let (x2, y2, z2) = (x + x, y + y, z + z);
+    let (xx, yy, zz) = (x * x2, y * y2, z * z2);
+    let (xy, xz, yz) = (x * y2, x * z2, y * z2);
+    let (wx, wy, wz) = (w * x2, w * y2, w * z2);
+    let one = L::splat(1.0);
+    let cols = [
+        [one - (yy + zz), xy + wz, xz - wy],
+        [xy - wz, one - (xx + zz), yz + wx],
+        [xz + wy, yz - wx, one - (xx + yy)],
+    ];
+    let rho = one + ((xx + yy) + (zz + w * (w + w)));
+    (cols, rho)
+}
+
+/// The box scaled per axis, `s ∘ [lo, hi]`: each face the smaller (larger) of `s·lo` and
+/// `s·hi`, one rounding each (relative `u`, or `2^-150` absolute below the normal range).
+#[inline(always)]
+pub(crate) fn scale_box<V: Lane>(s: V, lo: V, hi: V) -> (V, V) {
+    let (a, b) = (s * lo, s * hi);
+    (a.min(b), a.max(b))
+}
+
+/// The Outward pad of a quaternion class: `k·u·S + 2ρ·TINY_PAD`, with
+/// `S_i = |t_i| + ρ·Σ_j max(|lo_j|, |hi_j|)` over the (already scaled) box.
+///
+/// Why `k = n + 2` suffices for the Nearest order `n` of [`rotation`] plus the method: as
+/// in [`outward_pad`], the computed `S` is at least `S·(1 − γ(N + 6))` (the box's scaling
+/// and `ρ`'s five roundings included), which the surplus `u·S` of the pad absorbs; the
+/// absolute part `2ρ·TINY_PAD` covers the Nearest absolute error `2ρ·TINY_ERROR` plus the
+/// underflow of the pad itself.
+#[inline(always)]
+pub(crate) fn rotation_pad<V: Axes>(rho: V, t: V, lo: V, hi: V, k: u32) -> V {
+    let magnitude = hi.max(-lo);
+    let sum = magnitude.axis(0) + magnitude.axis(1) + magnitude.axis(2);
+    let s = rho.mul_add(sum, t.abs());
+    s.mul_add(
+        V::splat(k as f32 * UNIT_ROUNDOFF),
+        rho * V::splat(2.0 * TINY_PAD),
+    )
 }

@@ -14,7 +14,7 @@ use glam::Vec3A;
 ///
 /// `mul_add` is fused only where the lane type says so at compile time: a default
 /// build never calls `fmaf`.
-pub(crate) trait Lane:
+pub trait Lane:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
 {
     /// Every lane set to `x`.
@@ -32,7 +32,7 @@ pub(crate) trait Lane:
 }
 
 /// A lane type whose lanes are the components of a vector, able to broadcast one of them.
-pub(crate) trait Axes: Lane {
+pub trait Axes: Lane {
     /// The vector with every component equal to component `j` of `self`.
     fn axis(self, j: usize) -> Self;
 }
@@ -114,7 +114,7 @@ impl Axes for Vec3A {
 /// An `N`-vector whose components are lanes `L`: component `i` of box lane `k` is
 /// `self.0[i]` lane `k`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Vector<L, const N: usize>(pub [L; N]);
+pub struct Vector<L, const N: usize>(pub [L; N]);
 
 impl<L: Lane, const N: usize> Vector<L, N> {
     // Indexed loops rather than `array::from_fn`/`map`: their closures and internal

@@ -15,6 +15,30 @@
 //! }
 //! ```
 //!
+//! ## Transform classes
+//! Model only what the scene requires: every entry point takes any class of
+//! [`transform`], each with the cheapest kernel that is exact for it and its own bytes per
+//! box: [`Translation3`] (spheres, particles: 12 bytes), [`Rigid3`] (quaternion +
+//! position: 28), [`Similarity3`] (plus a uniform scale: 32), [`Trs3`] (bevy's
+//! `Transform`: 40) and `glam::Affine3A` (48 useful bytes); in 2D [`Translation2`],
+//! [`Rigid2`] and `glam::Affine2`.
+//!
+//! ```
+//! use bvkit::{Aabb3, Batch, Method, Rigid3, Rounding};
+//! use glam::{Quat, Vec3, Vec3A};
+//!
+//! let local = vec![Aabb3::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)); 64];
+//! let poses: Vec<Rigid3> = (0..64)
+//!     .map(|k| (Quat::from_rotation_y(k as f32), Vec3::X * k as f32).into())
+//!     .collect();
+//! let mut world = vec![Aabb3::EMPTY; 64];
+//! // One generic entry point: any box layout, any transform class, any transform layout.
+//! Batch::new(Method::AbsMatrix, Rounding::Outward).transform(&local, &poses, &mut world)?;
+//! let pose = glam::Affine3A::from(poses[3]);
+//! assert!(local[3].corners().iter().all(|&c| world[3].contains_point(pose.transform_point3a(c))));
+//! # Ok::<(), bvkit::BatchError>(())
+//! ```
+//!
 //! ## Methods
 //! - [`Method::Naive`]: transform every corner, take min and max (the baseline).
 //! - [`Method::AbsMatrix`]: Arvo's center/extent form, `M c + t ± |M| e`.
@@ -34,6 +58,9 @@
 //!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
+// The public traits (`Transform3`, `BoxSource`, …) are sealed: their machinery (lane types,
+// kernels) is crate-private by design and reachable only through the sealed supertraits.
+#![allow(private_interfaces, private_bounds)]
 
 mod aabb;
 mod batch;
@@ -44,18 +71,17 @@ mod kernel;
 mod lane;
 pub mod method;
 mod projective;
-mod rigid2;
 mod simd;
-mod transform;
+mod single;
+pub mod transform;
 
 pub use aabb::{Aabb2, Aabb3};
-pub use batch::{
-    Aabb3x8, AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef, Affine3x8, Batch,
-    BatchError, transform_slice,
-};
+pub use batch::*;
 pub use error::TransformError;
 pub use method::{Method, Rounding};
-pub use rigid2::Rigid2;
 pub use simd::Backend;
+pub use transform::{
+    Rigid2, Rigid3, Similarity3, Transform2, Transform3, Translation2, Translation3, Trs3,
+};
 
 pub use glam;

@@ -111,9 +111,10 @@ pub fn roofline_aosoa(boxes: &[Aabb3x8], xfs: &[Affine3x8], out: &mut [Aabb3x8])
     for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
         for a in 0..3 {
             for k in 0..8 {
-                let m = x.cols[0][a][k] + x.cols[1][a][k] + x.cols[2][a][k] + x.translation[a][k];
-                o.min[a][k] = b.min[a][k] + m;
-                o.max[a][k] = b.max[a][k] + m;
+                let c = &x.fields;
+                let m = c[a][k] + c[3 + a][k] + c[6 + a][k] + c[9 + a][k];
+                o.fields[a][k] = b.fields[a][k] + m;
+                o.fields[3 + a][k] = b.fields[3 + a][k] + m;
             }
         }
     }
@@ -122,14 +123,10 @@ pub fn roofline_aosoa(boxes: &[Aabb3x8], xfs: &[Affine3x8], out: &mut [Aabb3x8])
 /// Memory roofline for SoA columns (6 box columns, 12 transform columns, 6 outputs).
 pub fn roofline_soa(boxes: &bvkit::AabbSoa, xfs: &bvkit::Affine3Soa, out: &mut bvkit::AabbSoa) {
     for a in 0..3 {
-        let (c0, c1, c2, t) = (
-            &xfs.cols[0][a],
-            &xfs.cols[1][a],
-            &xfs.cols[2][a],
-            &xfs.translation[a],
-        );
-        let (lo, hi) = (&boxes.min[a], &boxes.max[a]);
-        let [omin, omax] = [&mut out.min[a], &mut out.max[a]];
+        let c = &xfs.columns;
+        let (c0, c1, c2, t) = (&c[a], &c[3 + a], &c[6 + a], &c[9 + a]);
+        let (lo, hi) = (&boxes.columns[a], &boxes.columns[3 + a]);
+        let [omin, omax] = out.columns.get_disjoint_mut([a, 3 + a]).expect("distinct");
         for k in 0..lo.len() {
             let m = c0[k] + c1[k] + c2[k] + t[k];
             omin[k] = lo[k] + m;
@@ -143,5 +140,84 @@ pub fn roofline_aos(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
     for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
         let m = x.matrix3.x_axis + x.matrix3.y_axis + x.matrix3.z_axis + x.translation;
         *o = Aabb3::new(b.min + m, b.max + m);
+    }
+}
+
+/// One scene in every transform class: the same boxes, and poses that differ only in what
+/// each class can hold (a translation, then a rotation, a uniform scale, a per-axis scale).
+pub struct ClassScene {
+    pub boxes: Vec<Aabb3>,
+    pub translation: Vec<bvkit::Translation3>,
+    pub rigid: Vec<bvkit::Rigid3>,
+    pub similarity: Vec<bvkit::Similarity3>,
+    pub trs: Vec<bvkit::Trs3>,
+    /// The scale-rotation-translation poses as glam affine maps (the general class).
+    pub affine: Vec<Affine3A>,
+    /// The rigid poses, for the peers.
+    pub poses: Vec<(Quat, Vec3)>,
+}
+
+/// `n` boxes and poses of a typical scene in every class.
+pub fn class_scene(n: usize, seed: u64) -> ClassScene {
+    let (boxes, _, poses) = scene(n, seed);
+    let mut r = Xorshift(seed ^ 0x9e37_79b9_7f4a_7c15 | 1);
+    let scales: Vec<Vec3A> = (0..n)
+        .map(|_| Vec3A::new(r.range(0.5, 2.0), r.range(0.5, 2.0), r.range(0.5, 2.0)))
+        .collect();
+    let rigid: Vec<bvkit::Rigid3> = poses.iter().map(|&p| p.into()).collect();
+    let trs: Vec<bvkit::Trs3> = rigid
+        .iter()
+        .zip(&scales)
+        .map(|(p, &s)| bvkit::Trs3::new(s, p.rotation, p.translation))
+        .collect();
+    ClassScene {
+        translation: rigid
+            .iter()
+            .map(|p| bvkit::Translation3(p.translation))
+            .collect(),
+        similarity: rigid
+            .iter()
+            .zip(&scales)
+            .map(|(p, s)| bvkit::Similarity3::new(s.x, p.rotation, p.translation))
+            .collect(),
+        affine: trs.iter().map(|&p| p.into()).collect(),
+        boxes,
+        rigid,
+        trs,
+        poses,
+    }
+}
+
+/// The glam loop a user writes for rigid poses: the rotation matrix, then abs-matrix.
+pub fn glam_rigid_abs_matrix(boxes: &[Aabb3], poses: &[bvkit::Rigid3], out: &mut [Aabb3]) {
+    for ((b, p), o) in boxes.iter().zip(poses).zip(out) {
+        let m = glam::Mat3A::from_quat(p.rotation);
+        let c = m * ((b.min + b.max) * 0.5) + p.translation;
+        let e = (b.max - b.min) * 0.5;
+        let we = m.x_axis.abs() * e.x + m.y_axis.abs() * e.y + m.z_axis.abs() * e.z;
+        *o = Aabb3::new(c - we, c + we);
+    }
+}
+
+/// Memory roofline for AoSoA blocks of any class with `F` fields: reads every byte of the
+/// boxes and transforms and writes every byte of the output, with one addition per input
+/// float.
+pub fn roofline_blocks<const F: usize>(
+    boxes: &[[[f32; 8]; 6]],
+    xfs: &[[[f32; 8]; F]],
+    out: &mut [[[f32; 8]; 6]],
+) {
+    for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
+        let mut m = [0.0f32; 8];
+        for field in x {
+            for k in 0..8 {
+                m[k] += field[k];
+            }
+        }
+        for n in 0..6 {
+            for k in 0..8 {
+                o[n][k] = b[n][k] + m[k];
+            }
+        }
     }
 }

@@ -5,7 +5,7 @@
 pub mod oracle;
 
 use bvkit::{Aabb2, Method, Rigid2, Rounding};
-use oracle::{Bound, Problem};
+use oracle::{Bound, Exactly, Problem, QuatProblem};
 
 pub use oracle::{affine2, affine3};
 
@@ -80,11 +80,41 @@ impl<'a> Floats<'a> {
         }
         Problem { cols, t, lo, hi }
     }
+
+    /// A quaternion problem; `scale` is `None` (unit), `Some(true)` (uniform) or
+    /// `Some(false)` (per axis). The quaternion is any four floats: unit, drifted, zero,
+    /// huge, NaN or infinite.
+    pub fn quat_problem(&mut self, scale: Option<bool>) -> QuatProblem {
+        let p = self.problem::<3>();
+        let q = self.array();
+        let s = match scale {
+            None => [1.0; 3],
+            Some(true) => [self.next(); 3],
+            Some(false) => self.array(),
+        };
+        QuatProblem {
+            q,
+            s,
+            t: p.t,
+            lo: p.lo,
+            hi: p.hi,
+        }
+    }
+
+    /// A translation problem: the identity matrix.
+    pub fn translation_problem<const N: usize>(&mut self) -> Problem<N> {
+        let p = self.problem::<N>();
+        let mut cols = [[0.0; N]; N];
+        for (j, col) in cols.iter_mut().enumerate() {
+            col[j] = 1.0;
+        }
+        Problem { cols, ..p }
+    }
 }
 
 /// Panics with the problem when `min`/`max` break the contract.
 pub fn assert_contract<const N: usize>(
-    p: &Problem<N>,
+    p: &impl Exactly<N>,
     min: [f32; N],
     max: [f32; N],
     bound: Bound,
@@ -109,4 +139,9 @@ pub fn rigid2(p: &Problem<2>) -> (Problem<2>, Aabb2, Rigid2) {
 /// The bound bvkit documents (see [`Bound::documented`]).
 pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
     Bound::documented(method, rounding, dims)
+}
+
+/// The bound of a class of order `n` (its `nearest_gamma(method)`).
+pub fn bound_of(n: u32, rounding: Rounding) -> Bound {
+    Bound::of_order(n, rounding)
 }

@@ -1,293 +1,251 @@
 //! AoSoA blocks: eight boxes or eight transforms per 32-byte-aligned block, one `[f32; 8]`
 //! per scalar field, so that a lane block is a handful of aligned vector loads.
 
-use glam::{Affine3A, Mat3A, Vec3A};
+use glam::{Affine2, Affine3A};
 
-use super::{BatchError, BoxSink, BoxSource, MapSource};
-use crate::aabb::Aabb3;
-use crate::kernel::AffineLanes;
-use crate::lane::{Lane, Vector};
+use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{BatchError, box_lanes, zero_fields};
+use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::lane::Vector;
 use crate::simd::LaneArray;
+use crate::transform::{
+    Class, Fields, MAX_FIELDS, Rigid2, Rigid3, Similarity3, Translation2, Translation3, Trs3,
+};
 
-/// Eight 3D boxes, field by field: `min[axis][box]`, `max[axis][box]` (6 × `[f32; 8]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Eight values of `T` (boxes or transforms), field by field: `fields[n][k]` is field `n`
+/// of value `k`, in the field order of `T` (a box: `min` then `max`; a transform: see its
+/// class). Aliases name the common ones ([`Rigid3x8`], [`Aabb3x8`], …).
 #[repr(C, align(32))]
-pub struct Aabb3x8 {
-    /// The lower corners, one `[f32; 8]` per axis.
-    pub min: [[f32; 8]; 3],
-    /// The upper corners, one `[f32; 8]` per axis.
-    pub max: [[f32; 8]; 3],
+pub struct Block8<T: Fields> {
+    /// The fields, eight lanes each (`[[f32; 8]; F]` for `F` fields).
+    pub fields: T::Array<[f32; 8]>,
 }
 
-/// Eight 3D affine transforms, field by field: `cols[j][i][k]` is entry `m_ij` of
-/// transform `k`, `translation[i][k]` its translation (12 × `[f32; 8]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
-pub struct Affine3x8 {
-    /// The columns of the linear parts.
-    pub cols: [[[f32; 8]; 3]; 3],
-    /// The translations.
-    pub translation: [[f32; 8]; 3],
+/// Eight 3D boxes: fields `min.x, min.y, min.z, max.x, max.y, max.z`.
+pub type Aabb3x8 = Block8<Aabb3>;
+/// Eight 2D boxes: fields `min.x, min.y, max.x, max.y`.
+pub type Aabb2x8 = Block8<Aabb2>;
+/// Eight 3D affine transforms: the columns of the matrix, then the translation.
+pub type Affine3x8 = Block8<Affine3A>;
+/// Eight 2D affine transforms: the columns of the matrix, then the translation.
+pub type Affine2x8 = Block8<Affine2>;
+/// Eight 3D translations.
+pub type Translation3x8 = Block8<Translation3>;
+/// Eight 2D translations.
+pub type Translation2x8 = Block8<Translation2>;
+/// Eight rigid 3D poses: quaternion `x, y, z, w`, then the translation.
+pub type Rigid3x8 = Block8<Rigid3>;
+/// Eight 3D similarities: quaternion, translation, then the scale.
+pub type Similarity3x8 = Block8<Similarity3>;
+/// Eight scale-rotation-translations: quaternion, translation, then the three scales.
+pub type Trs3x8 = Block8<Trs3>;
+/// Eight rigid 2D poses: `cos, sin`, then the translation.
+pub type Rigid2x8 = Block8<Rigid2>;
+
+impl<T: Fields> Clone for Block8<T>
+where
+    T::Array<[f32; 8]>: Clone,
+{
+    fn clone(&self) -> Self {
+        Self {
+            fields: self.fields.clone(),
+        }
+    }
 }
 
-impl Aabb3x8 {
-    /// Eight empty boxes.
-    pub const EMPTY: Self = Self {
-        min: [[f32::INFINITY; 8]; 3],
-        max: [[f32::NEG_INFINITY; 8]; 3],
-    };
+impl<T: Fields> Copy for Block8<T> where T::Array<[f32; 8]>: Copy {}
 
-    /// Box `k` of the block.
+impl<T: Fields> PartialEq for Block8<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.fields.as_ref() == other.fields.as_ref()
+    }
+}
+
+impl<T: Fields> core::fmt::Debug for Block8<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Block8")
+            .field("fields", &self.fields.as_ref())
+            .finish()
+    }
+}
+
+impl<T: Fields> Block8<T> {
+    /// A block from its fields.
     #[inline]
     #[must_use]
-    pub fn get(&self, k: usize) -> Aabb3 {
-        Aabb3::new(
-            Vec3A::from_array(self.min.map(|a| a[k])),
-            Vec3A::from_array(self.max.map(|a| a[k])),
-        )
+    pub fn from_fields(fields: T::Array<[f32; 8]>) -> Self {
+        Self { fields }
     }
 
-    /// Sets box `k` of the block.
+    /// Eight copies of `value`.
+    #[must_use]
+    pub fn splat(value: T) -> Self {
+        let v = value.to_fields();
+        Self::from_fields(T::array(|n| [v[n]; 8]))
+    }
+
+    /// Value `k` of the block.
     #[inline]
-    pub fn set(&mut self, k: usize, b: Aabb3) {
-        for a in 0..3 {
-            self.min[a][k] = b.min[a];
-            self.max[a][k] = b.max[a];
+    #[must_use]
+    pub fn get(&self, k: usize) -> T {
+        let mut v = [0.0; MAX_FIELDS];
+        for (x, field) in v.iter_mut().zip(self.fields.as_ref()) {
+            *x = field[k];
+        }
+        T::from_fields(&v)
+    }
+
+    /// Sets value `k` of the block.
+    #[inline]
+    pub fn set(&mut self, k: usize, value: T) {
+        let v = value.to_fields();
+        for (field, x) in self.fields.as_mut().iter_mut().zip(v) {
+            field[k] = x;
         }
     }
 
-    /// Packs boxes into blocks, the last one padded with `EMPTY`.
+    /// Packs values into blocks, the last one padded (identity transforms, empty boxes).
     #[must_use]
-    pub fn pack(boxes: &[Aabb3]) -> Vec<Aabb3x8> {
-        boxes
+    pub fn pack(values: &[T]) -> Vec<Self> {
+        values
             .chunks(8)
             .map(|chunk| {
-                let mut block = Self::EMPTY;
-                chunk.iter().enumerate().for_each(|(k, &b)| block.set(k, b));
+                let mut block = Self::default();
+                chunk.iter().enumerate().for_each(|(k, &v)| block.set(k, v));
                 block
             })
             .collect()
     }
 
-    /// Unpacks the first `len` boxes of the blocks.
+    /// Unpacks the first `len` values of the blocks.
     #[must_use]
-    pub fn unpack(blocks: &[Aabb3x8], len: usize) -> Vec<Aabb3> {
+    pub fn unpack(blocks: &[Self], len: usize) -> Vec<T> {
         (0..len.min(blocks.len() * 8))
-            .map(|b| blocks[b / 8].get(b % 8))
+            .map(|i| blocks[i / 8].get(i % 8))
             .collect()
     }
 }
 
-impl From<[Aabb3; 8]> for Aabb3x8 {
-    #[inline]
-    fn from(boxes: [Aabb3; 8]) -> Self {
-        Self {
-            min: core::array::from_fn(|a| boxes.map(|b| b.min[a])),
-            max: core::array::from_fn(|a| boxes.map(|b| b.max[a])),
-        }
+/// Eight copies of the padding value: identity transforms, or empty boxes.
+impl<T: Fields> Default for Block8<T> {
+    fn default() -> Self {
+        Self::splat(T::PADDING)
     }
 }
 
-impl From<Aabb3x8> for [Aabb3; 8] {
+impl<T: Fields> From<[T; 8]> for Block8<T> {
     #[inline]
-    fn from(block: Aabb3x8) -> Self {
-        core::array::from_fn(|k| block.get(k))
-    }
-}
-
-impl Affine3x8 {
-    /// Eight identity transforms.
-    pub const IDENTITY: Self = Self {
-        cols: [
-            [[1.0; 8], [0.0; 8], [0.0; 8]],
-            [[0.0; 8], [1.0; 8], [0.0; 8]],
-            [[0.0; 8], [0.0; 8], [1.0; 8]],
-        ],
-        translation: [[0.0; 8]; 3],
-    };
-
-    /// Transform `k` of the block.
-    #[inline]
-    #[must_use]
-    pub fn get(&self, k: usize) -> Affine3A {
-        let col = |j: usize| Vec3A::from_array(self.cols[j].map(|a| a[k]));
-        Affine3A {
-            matrix3: Mat3A::from_cols(col(0), col(1), col(2)),
-            translation: Vec3A::from_array(self.translation.map(|a| a[k])),
-        }
-    }
-
-    /// Sets transform `k` of the block.
-    #[inline]
-    pub fn set(&mut self, k: usize, xf: &Affine3A) {
-        for j in 0..3 {
-            for i in 0..3 {
-                self.cols[j][i][k] = xf.matrix3.col(j)[i];
-            }
-        }
-        for i in 0..3 {
-            self.translation[i][k] = xf.translation[i];
-        }
-    }
-
-    /// Packs transforms into blocks, the last one padded with identities.
-    #[must_use]
-    pub fn pack(xfs: &[Affine3A]) -> Vec<Affine3x8> {
-        xfs.chunks(8)
-            .map(|chunk| {
-                let mut block = Self::IDENTITY;
-                chunk
-                    .iter()
-                    .enumerate()
-                    .for_each(|(k, xf)| block.set(k, xf));
-                block
-            })
-            .collect()
-    }
-}
-
-impl From<[Affine3A; 8]> for Affine3x8 {
-    #[inline]
-    fn from(xfs: [Affine3A; 8]) -> Self {
-        let mut block = Self::IDENTITY;
-        xfs.iter().enumerate().for_each(|(k, xf)| block.set(k, xf));
+    fn from(values: [T; 8]) -> Self {
+        let mut block = Self::default();
+        values
+            .iter()
+            .enumerate()
+            .for_each(|(k, &v)| block.set(k, v));
         block
     }
 }
 
-impl From<Affine3x8> for [Affine3A; 8] {
+impl<T: Fields> From<Block8<T>> for [T; 8] {
     #[inline]
-    fn from(block: Affine3x8) -> Self {
+    fn from(block: Block8<T>) -> Self {
         core::array::from_fn(|k| block.get(k))
     }
 }
 
-/// True when lanes `i..i + count` fill a whole lane block that lies inside one AoSoA
-/// block (`i` is a multiple of the lane width, which divides 8): then each field is one
-/// vector load. Otherwise (the tail, or 16 lanes spanning two blocks) lanes go one by one.
-#[inline(always)]
-fn whole<L: LaneArray>(count: usize) -> bool {
-    count == L::WIDTH && 8 % L::WIDTH == 0
-}
-
-/// Lanes `slot..slot + L::WIDTH` of three fields of a block: three vector loads (a
-/// function, not a closure, so that it is always inlined).
-#[inline(always)]
-fn fields<L: LaneArray>(f: &[[f32; 8]; 3], slot: usize) -> Vector<L, 3> {
-    Vector([
-        L::load(&f[0][slot..]),
-        L::load(&f[1][slot..]),
-        L::load(&f[2][slot..]),
-    ])
-}
-
-impl BoxSource<3> for &[Aabb3x8] {
+impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
     fn len(&self) -> Result<usize, BatchError> {
-        Ok(<[Aabb3x8]>::len(self) * 8)
+        Ok(<[Block8<B>]>::len(self) * 8)
     }
     #[inline(always)]
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
-        if whole::<L>(count) {
-            let (block, slot) = (&self[i / 8], i % 8);
-            return (fields(&block.min, slot), fields(&block.max, slot));
-        }
-        let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
-        for k in 0..L::WIDTH {
-            if k < count {
-                let (block, slot) = (&self[(i + k) / 8], (i + k) % 8);
-                for a in 0..3 {
-                    lo.0[a].set(k, block.min[a][slot]);
-                    hi.0[a].set(k, block.max[a][slot]);
-                }
-            }
-        }
-        (lo, hi)
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
+        box_lanes(&gather_blocks::<L, B>(self, i, count))
     }
-    fn get(&self, i: usize) -> ([f32; 3], [f32; 3]) {
-        let b = self[i / 8].get(i % 8);
-        (b.min.to_array(), b.max.to_array())
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
+        let (lo, hi) = box_lanes::<f32, N>(&self[i / 8].get(i % 8).to_fields());
+        (lo.0, hi.0)
     }
 }
 
-impl BoxSink<3> for &mut [Aabb3x8] {
-    fn len(&self) -> Result<usize, BatchError> {
-        Ok(<[Aabb3x8]>::len(self) * 8)
+impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
+    fn len(&mut self) -> Result<usize, BatchError> {
+        Ok(<[Block8<B>]>::len(self) * 8)
     }
     #[inline(always)]
     fn store<L: LaneArray>(
         &mut self,
         i: usize,
         count: usize,
-        min: Vector<L, 3>,
-        max: Vector<L, 3>,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
     ) {
-        if whole::<L>(count) {
+        if count == L::WIDTH && 8 % L::WIDTH == 0 {
             let (block, slot) = (&mut self[i / 8], i % 8);
-            for a in 0..3 {
-                min.0[a].store(&mut block.min[a][slot..]);
-                max.0[a].store(&mut block.max[a][slot..]);
+            for a in 0..N {
+                let fields = block.fields.as_mut();
+                min.0[a].store(&mut fields[a][slot..]);
+                max.0[a].store(&mut fields[N + a][slot..]);
             }
             return;
         }
         for k in 0..L::WIDTH {
             if k < count {
                 let (block, slot) = (&mut self[(i + k) / 8], (i + k) % 8);
-                for a in 0..3 {
-                    block.min[a][slot] = min.0[a].get(k);
-                    block.max[a][slot] = max.0[a].get(k);
+                let fields = block.fields.as_mut();
+                for a in 0..N {
+                    fields[a][slot] = min.0[a].get(k);
+                    fields[N + a][slot] = max.0[a].get(k);
                 }
             }
         }
     }
-    fn set(&mut self, i: usize, min: [f32; 3], max: [f32; 3]) {
-        self[i / 8].set(
-            i % 8,
-            Aabb3::new(Vec3A::from_array(min), Vec3A::from_array(max)),
-        );
+    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
+        let fields = self[i / 8].fields.as_mut();
+        for a in 0..N {
+            fields[a][i % 8] = min[a];
+            fields[N + a][i % 8] = max[a];
+        }
     }
 }
 
-impl MapSource<3> for &[Affine3x8] {
-    type Lanes<L: LaneArray> = AffineLanes<Vector<L, 3>, 3>;
+impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
+    type Class = T;
     fn len(&self) -> Option<usize> {
-        Some(<[Affine3x8]>::len(self) * 8)
+        Some(<[Block8<T>]>::len(self) * 8)
     }
     #[inline(always)]
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        if whole::<L>(count) {
-            let (block, slot) = (&self[i / 8], i % 8);
-            return AffineLanes {
-                cols: [
-                    fields(&block.cols[0], slot),
-                    fields(&block.cols[1], slot),
-                    fields(&block.cols[2], slot),
-                ],
-                t: fields(&block.translation, slot),
-            };
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
+        T::lanes(&gather_blocks::<L, T>(self, i, count))
+    }
+    fn get(&self, i: usize) -> T {
+        self[i / 8].get(i % 8)
+    }
+}
+
+/// Lanes `i..i + count` of every field of the blocks. When they fill a whole lane block
+/// inside one AoSoA block (`i` a multiple of the lane width, which divides 8) each field
+/// is one vector load; otherwise (the tail, or 16 lanes spanning two blocks) lanes go one
+/// by one.
+#[inline(always)]
+fn gather_blocks<L: LaneArray, T: Fields>(
+    blocks: &[Block8<T>],
+    i: usize,
+    count: usize,
+) -> [L; MAX_FIELDS] {
+    let mut f = zero_fields::<L>();
+    if count == L::WIDTH && 8 % L::WIDTH == 0 {
+        let (fields, slot) = (blocks[i / 8].fields.as_ref(), i % 8);
+        for n in 0..T::FIELDS {
+            f[n] = L::load(&fields[n][slot..]);
         }
-        let mut map = AffineLanes {
-            cols: [Vector::<L, 3>::splat(0.0); 3],
-            t: Vector::splat(0.0),
-        };
-        for k in 0..L::WIDTH {
-            if k < count {
-                let (block, slot) = (&self[(i + k) / 8], (i + k) % 8);
-                for a in 0..3 {
-                    for j in 0..3 {
-                        map.cols[j].0[a].set(k, block.cols[j][a][slot]);
-                    }
-                    map.t.0[a].set(k, block.translation[a][slot]);
-                }
+        return f;
+    }
+    for k in 0..L::WIDTH {
+        if k < count {
+            let (fields, slot) = (blocks[(i + k) / 8].fields.as_ref(), (i + k) % 8);
+            for n in 0..T::FIELDS {
+                f[n].set(k, fields[n][slot]);
             }
         }
-        map
     }
-    fn get(&self, i: usize) -> ([[f32; 3]; 3], [f32; 3]) {
-        let block = &self[i / 8];
-        let slot = i % 8;
-        (
-            block.cols.map(|c| c.map(|row| row[slot])),
-            block.translation.map(|row| row[slot]),
-        )
-    }
+    f
 }

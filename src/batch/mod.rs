@@ -1,14 +1,20 @@
-//! Batch transforms: many boxes at once, in three layouts, on the best backend.
+//! Batch transforms: many boxes at once, in any layout, through any transform class, on
+//! the best backend.
 //!
-//! - AoSoA blocks ([`Aabb3x8`], [`Affine3x8`]): the fast path.
-//! - SoA columns ([`AabbSoaRef`], [`AabbSoaMut`], [`Affine3SoaRef`]): ECS-style storage.
-//! - AoS slices (`&[Aabb3]`, `&[Affine3A]`, and 2D `&[Aabb2]` with `&[Affine2]` or
-//!   `&[Rigid2]`): convenience.
+//! One entry point, [`Batch::transform`], takes a [`BoxSource`], a [`TransformSource`] and
+//! a [`BoxSink`]:
 //!
-//! Every layout has a shared-transform form (one transform for the whole batch). All
-//! run the same lane-generic kernels as the single-box path and keep the same contract;
-//! lengths are checked before anything is written, and any length is accepted (the
-//! last partial block runs with masked lanes).
+//! | layout | boxes read | boxes written | transforms read |
+//! |---|---|---|---|
+//! | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
+//! | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T, F>]` (`&[Rigid3x8]`, …) |
+//! | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
+//! | shared | | | `&T`: one transform for the whole batch |
+//!
+//! `T` is any transform class ([`crate::transform`]); 2D boxes (`Aabb2`) work the same
+//! way. Every combination runs the same lane-generic kernels as the single-box path and
+//! keeps the same contract; lengths are checked before anything is written, and any
+//! length is accepted (the last partial block runs with masked lanes).
 
 mod aos;
 mod aosoa;
@@ -16,18 +22,23 @@ mod soa;
 
 use core::fmt;
 
-use glam::{Affine2, Affine3A};
-
-use crate::aabb::{Aabb2, Aabb3};
-use crate::block::{self, MapLanes};
+use crate::block;
 use crate::extended;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
-use crate::rigid2::Rigid2;
 use crate::simd::{self, Backend, Job, LaneArray};
+use crate::transform::{Class, Transform3};
 
-pub use aosoa::{Aabb3x8, Affine3x8};
-pub use soa::{AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef};
+pub use aosoa::{
+    Aabb2x8, Aabb3x8, Affine2x8, Affine3x8, Block8, Rigid2x8, Rigid3x8, Similarity3x8,
+    Translation2x8, Translation3x8, Trs3x8,
+};
+pub use soa::{
+    Aabb2Soa, Aabb2SoaMut, Aabb2SoaRef, AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef,
+    Soa, SoaMut, SoaRef,
+};
+
+use crate::aabb::Aabb3;
 
 /// Why a batch was refused. Nothing was written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,40 +74,80 @@ impl fmt::Display for BatchError {
 
 impl std::error::Error for BatchError {}
 
-/// Boxes to read, in some layout.
-pub(crate) trait BoxSource<const N: usize> {
-    /// The number of boxes, or an error when the layout's columns disagree.
-    fn len(&self) -> Result<usize, BatchError>;
-    /// Boxes `i..i + count` (`count <= L::WIDTH`) as lanes; lanes past `count` are zero.
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
-    /// Box `i` as `(min, max)`, for the extended path.
-    fn get(&self, i: usize) -> ([f32; N], [f32; N]);
+/// Boxes a batch reads, in some layout: see the [module docs](crate::batch) for the list.
+pub trait BoxSource<const N: usize>: sealed::ReadBoxes<N> {}
+impl<const N: usize, S: sealed::ReadBoxes<N>> BoxSource<N> for S {}
+
+/// Boxes a batch writes, in some layout.
+pub trait BoxSink<const N: usize>: sealed::WriteBoxes<N> {}
+impl<const N: usize, S: sealed::WriteBoxes<N>> BoxSink<N> for S {}
+
+/// Transforms a batch reads: one per box in some layout, or one shared by all.
+pub trait TransformSource<const N: usize>: sealed::ReadMaps<N> {}
+impl<const N: usize, S: sealed::ReadMaps<N>> TransformSource<N> for S {}
+
+pub(crate) mod sealed {
+    //! What a layout must do: load lanes, store lanes, and hand single items to the
+    //! extended path.
+
+    use super::*;
+
+    /// Boxes to read.
+    pub trait ReadBoxes<const N: usize> {
+        /// The number of boxes, or an error when the layout's columns disagree.
+        fn len(&self) -> Result<usize, BatchError>;
+        /// Boxes `i..i + count` (`count <= L::WIDTH`) as lanes; lanes past `count` are zero.
+        fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
+        /// Box `i` as `(min, max)`, for the extended path.
+        fn get(&self, i: usize) -> ([f32; N], [f32; N]);
+    }
+
+    /// Boxes to write.
+    pub trait WriteBoxes<const N: usize> {
+        /// The number of boxes, or an error when the layout's columns disagree (`&mut`, so
+        /// that a `Vec` can ask its slice).
+        fn len(&mut self) -> Result<usize, BatchError>;
+        /// Writes lanes `0..count` to boxes `i..i + count`.
+        fn store<L: LaneArray>(
+            &mut self,
+            i: usize,
+            count: usize,
+            min: Vector<L, N>,
+            max: Vector<L, N>,
+        );
+        /// Writes box `i`.
+        fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
+    }
+
+    /// Transforms to read.
+    pub trait ReadMaps<const N: usize> {
+        /// The transform class.
+        type Class: Class<N>;
+        /// The number of transforms, `None` for one shared transform.
+        fn len(&self) -> Option<usize>;
+        /// Transforms `i..i + count` as lanes; lanes past `count` are zero.
+        fn load<L: LaneArray>(&self, i: usize, count: usize)
+        -> <Self::Class as Class<N>>::Lanes<L>;
+        /// Transform `i`, for the extended path.
+        fn get(&self, i: usize) -> Self::Class;
+    }
 }
 
-/// Boxes to write, in some layout.
-pub(crate) trait BoxSink<const N: usize> {
-    /// The number of boxes, or an error when the layout's columns disagree.
-    fn len(&self) -> Result<usize, BatchError>;
-    /// Writes lanes `0..count` to boxes `i..i + count`.
-    fn store<L: LaneArray>(&mut self, i: usize, count: usize, min: Vector<L, N>, max: Vector<L, N>);
-    /// Writes box `i`.
-    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
+use sealed::{ReadBoxes, ReadMaps, WriteBoxes};
+
+/// Box `(min, max)` lanes from the fields of a box type in lanes.
+#[inline(always)]
+fn box_lanes<L: Copy, const N: usize>(
+    f: &[L; crate::transform::MAX_FIELDS],
+) -> (Vector<L, N>, Vector<L, N>) {
+    (
+        crate::transform::vector_at(f, 0),
+        crate::transform::vector_at(f, N),
+    )
 }
 
-/// Transforms to read: one per box, or one shared by all.
-pub(crate) trait MapSource<const N: usize> {
-    /// The lanes a kernel runs on.
-    type Lanes<L: LaneArray>: MapLanes<L, N>;
-    /// The number of transforms, `None` for one shared transform.
-    fn len(&self) -> Option<usize>;
-    /// Transforms `i..i + count` as lanes; lanes past `count` are zero.
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L>;
-    /// Transform `i` as columns (`cols[j][i] = m_ij`) and translation.
-    fn get(&self, i: usize) -> ([[f32; N]; N], [f32; N]);
-}
-
-/// The job every batch entry point runs: blocks of lanes through the kernel.
-struct Run<B, X, O, const N: usize> {
+/// The job every batch runs: blocks of lanes through the kernel.
+struct Run<B, X, O> {
     local: B,
     xf: X,
     out: O,
@@ -105,24 +156,42 @@ struct Run<B, X, O, const N: usize> {
     rounding: Rounding,
 }
 
-impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Run<B, X, O, N> {
-    /// Every block with one kernel; `method` and `outward` are constants at each call site,
-    /// so that each loop is specialised to its kernel.
+impl<B, X, O> Run<B, X, O> {
+    /// Every block with one kernel; `method` is a constant at each call site, so that each
+    /// loop is specialised to its kernel.
     #[inline(always)]
-    fn blocks<L: LaneArray>(&mut self, method: Method, outward: bool) {
+    fn blocks<L: LaneArray, const N: usize>(&mut self, method: Method, outward: bool)
+    where
+        B: ReadBoxes<N>,
+        X: ReadMaps<N>,
+        O: WriteBoxes<N>,
+    {
         let w = L::WIDTH;
         let mut i = 0;
         while i + w <= self.len {
-            self.block::<L>(i, w, method, outward);
+            self.block::<L, N>(i, w, method, outward);
             i += w;
         }
-        if i < self.len {
-            self.block::<L>(i, self.len - i, method, outward);
+        // The tail one box at a time, in one lane of the same arithmetic: smaller code than
+        // a masked block, and the same bits.
+        while i < self.len {
+            self.block::<L::One, N>(i, 1, method, outward);
+            i += 1;
         }
     }
 
     #[inline(always)]
-    fn block<L: LaneArray>(&mut self, i: usize, count: usize, method: Method, outward: bool) {
+    fn block<L: LaneArray, const N: usize>(
+        &mut self,
+        i: usize,
+        count: usize,
+        method: Method,
+        outward: bool,
+    ) where
+        B: ReadBoxes<N>,
+        X: ReadMaps<N>,
+        O: WriteBoxes<N>,
+    {
         let (lo, hi) = self.local.load::<L>(i, count);
         let map = self.xf.load::<L>(i, count);
         let (min, max, stands) = block::transform(&map, lo, hi, method, outward);
@@ -134,8 +203,8 @@ impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Run<B, X, 
             for k in 0..count {
                 if stands.get(k) != 0.0 {
                     let (lo, hi) = self.local.get(i + k);
-                    let (cols, t) = self.xf.get(i + k);
-                    let (min, max) = extended::transform(cols, t, lo, hi, self.rounding);
+                    let map = self.xf.get(i + k).extended();
+                    let (min, max) = extended::transform(&map, lo, hi, self.rounding);
                     self.out.set(i + k, min, max);
                 }
             }
@@ -143,17 +212,21 @@ impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Run<B, X, 
     }
 }
 
-impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Job for Run<B, X, O, N> {
+/// A [`Run`] in `N` dimensions, as a [`Job`] for the dispatcher.
+struct RunN<const N: usize, B, X, O>(Run<B, X, O>);
+
+impl<const N: usize, B: ReadBoxes<N>, X: ReadMaps<N>, O: WriteBoxes<N>> Job for RunN<N, B, X, O> {
+    /// One loop per method, so that each is specialised to its kernel; the rounding is a
+    /// loop-invariant branch (specialising it too doubled the code, and the build time of
+    /// every call site, for no measurable speed).
     #[inline(always)]
-    fn run<L: LaneArray>(mut self) {
-        let outward = self.rounding == Rounding::Outward;
-        match (self.method, outward) {
-            (Method::Naive, false) => self.blocks::<L>(Method::Naive, false),
-            (Method::Naive, true) => self.blocks::<L>(Method::Naive, true),
-            (Method::AbsMatrix, false) => self.blocks::<L>(Method::AbsMatrix, false),
-            (Method::AbsMatrix, true) => self.blocks::<L>(Method::AbsMatrix, true),
-            (Method::SignSelect, false) => self.blocks::<L>(Method::SignSelect, false),
-            (Method::SignSelect, true) => self.blocks::<L>(Method::SignSelect, true),
+    fn run<L: LaneArray>(self) {
+        let mut run = self.0;
+        let outward = run.rounding == Rounding::Outward;
+        match run.method {
+            Method::Naive => run.blocks::<L, N>(Method::Naive, outward),
+            Method::AbsMatrix => run.blocks::<L, N>(Method::AbsMatrix, outward),
+            Method::SignSelect => run.blocks::<L, N>(Method::SignSelect, outward),
         }
     }
 }
@@ -161,13 +234,13 @@ impl<const N: usize, B: BoxSource<N>, X: MapSource<N>, O: BoxSink<N>> Job for Ru
 /// How a batch runs: the method, the rounding and the backend.
 ///
 /// ```
-/// use bvkit::{Aabb3, Batch, Method, Rounding};
-/// use glam::{Affine3A, Vec3, Vec3A};
+/// use bvkit::{Aabb3, Batch, Method, Rigid3, Rounding};
+/// use glam::{Quat, Vec3A};
 ///
 /// let local = vec![Aabb3::new(Vec3A::ZERO, Vec3A::ONE); 100];
-/// let poses = vec![Affine3A::from_translation(Vec3::X); 100];
+/// let poses = vec![Rigid3::new(Quat::IDENTITY, Vec3A::X); 100];
 /// let mut world = vec![Aabb3::EMPTY; 100];
-/// Batch::new(Method::AbsMatrix, Rounding::Outward).aos(&local, &poses, &mut world)?;
+/// Batch::new(Method::AbsMatrix, Rounding::Outward).transform(&local, &poses, &mut world)?;
 /// assert!(world[99].contains_point(Vec3A::new(2.0, 1.0, 1.0)));
 /// # Ok::<(), bvkit::BatchError>(())
 /// ```
@@ -209,14 +282,21 @@ impl Batch {
         self.backend
     }
 
-    fn run<const N: usize>(
+    /// `out[k] = local[k]` through transform `k` (or the shared transform) for every `k`:
+    /// every layout, every transform class, in 3D and 2D.
+    ///
+    /// # Errors
+    /// [`BatchError::LengthMismatch`] unless the boxes, the transforms (unless shared) and
+    /// the output have the same length, and the columns of a SoA layout agree; `out` is
+    /// then untouched.
+    pub fn transform<const N: usize>(
         &self,
         local: impl BoxSource<N>,
-        xf: impl MapSource<N>,
-        out: impl BoxSink<N>,
+        xf: impl TransformSource<N>,
+        mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
-        let len = checked_len(&local, &xf, &out)?;
-        let job: Run<_, _, _, N> = Run {
+        let len = checked_len(&local, &xf, &mut out)?;
+        let run = Run {
             local,
             xf,
             out,
@@ -224,25 +304,16 @@ impl Batch {
             method: self.method,
             rounding: self.rounding,
         };
-        simd::dispatch(self.backend, job);
+        simd::dispatch(self.backend, RunN::<N, _, _, _>(run));
         Ok(())
-    }
-
-    /// AoS 3D boxes one at a time on the single-box SIMD kernel (lanes = axes):
-    /// transposing AoS boxes into box lanes costs more than the lanes save. The scalar
-    /// backend keeps the lane path, which is the scalar reference.
-    fn per_box(&self, local: &[Aabb3], xf: impl Fn(usize) -> Affine3A, out: &mut [Aabb3]) {
-        for (i, (b, o)) in local.iter().zip(out).enumerate() {
-            *o = b.transformed(&xf(i), self.method, self.rounding);
-        }
     }
 }
 
 /// The common length of a batch, checked before anything is written.
 fn checked_len<const N: usize>(
-    local: &impl BoxSource<N>,
-    xf: &impl MapSource<N>,
-    out: &impl BoxSink<N>,
+    local: &impl ReadBoxes<N>,
+    xf: &impl ReadMaps<N>,
+    out: &mut impl WriteBoxes<N>,
 ) -> Result<usize, BatchError> {
     let len = local.len()?;
     let mismatch = |what, found| BatchError::LengthMismatch {
@@ -260,257 +331,151 @@ fn checked_len<const N: usize>(
     Ok(len)
 }
 
-impl Batch {
-    /// AoSoA blocks, one transform block per box block: the fast path.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless all three have the same number of blocks.
-    pub fn aosoa(
-        &self,
-        local: &[Aabb3x8],
-        xf: &[Affine3x8],
-        out: &mut [Aabb3x8],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// AoSoA blocks through one shared transform.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless `local` and `out` have the same number of blocks.
-    pub fn aosoa_shared(
-        &self,
-        local: &[Aabb3x8],
-        xf: &Affine3A,
-        out: &mut [Aabb3x8],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// SoA columns, one transform per box.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless every column has the same length.
-    pub fn soa(
-        &self,
-        local: AabbSoaRef<'_>,
-        xf: Affine3SoaRef<'_>,
-        out: AabbSoaMut<'_>,
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// SoA columns through one shared transform.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless every column has the same length.
-    pub fn soa_shared(
-        &self,
-        local: AabbSoaRef<'_>,
-        xf: &Affine3A,
-        out: AabbSoaMut<'_>,
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// AoS slices, one transform per box.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless all three slices have the same length.
-    pub fn aos(
-        &self,
-        local: &[Aabb3],
-        xf: &[Affine3A],
-        out: &mut [Aabb3],
-    ) -> Result<(), BatchError> {
-        if self.backend == Backend::Scalar {
-            return self.run(local, xf, out);
-        }
-        checked_len::<3>(&local, &xf, &out)?;
-        self.per_box(local, |i| xf[i], out);
-        Ok(())
-    }
-
-    /// AoS slices through one shared transform (compound bodies, instanced props).
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless `local` and `out` have the same length.
-    pub fn aos_shared(
-        &self,
-        local: &[Aabb3],
-        xf: &Affine3A,
-        out: &mut [Aabb3],
-    ) -> Result<(), BatchError> {
-        if self.backend == Backend::Scalar {
-            return self.run(local, xf, out);
-        }
-        checked_len::<3>(&local, &xf, &out)?;
-        self.per_box(local, |_| *xf, out);
-        Ok(())
-    }
-
-    /// 2D AoS slices, one affine transform per box.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless all three slices have the same length.
-    pub fn aos2(
-        &self,
-        local: &[Aabb2],
-        xf: &[Affine2],
-        out: &mut [Aabb2],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// 2D AoS slices through one shared affine transform.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless `local` and `out` have the same length.
-    pub fn aos2_shared(
-        &self,
-        local: &[Aabb2],
-        xf: &Affine2,
-        out: &mut [Aabb2],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// 2D AoS slices, one rigid transform per box; [`Method::SignSelect`] is Eberly's sign
-    /// branch in lanes.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless all three slices have the same length.
-    pub fn aos_rigid2(
-        &self,
-        local: &[Aabb2],
-        xf: &[Rigid2],
-        out: &mut [Aabb2],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-
-    /// 2D AoS slices through one shared rigid transform.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless `local` and `out` have the same length.
-    pub fn aos_rigid2_shared(
-        &self,
-        local: &[Aabb2],
-        xf: &Rigid2,
-        out: &mut [Aabb2],
-    ) -> Result<(), BatchError> {
-        self.run(local, xf, out)
-    }
-}
-
 /// `out[k] = local[k]` through `xf[k]` for every `k`, on the fastest backend of this CPU.
 ///
 /// # Errors
 /// [`BatchError::LengthMismatch`] unless all three slices have the same length; `out` is
 /// then untouched.
-pub fn transform_slice(
+pub fn transform_slice<T: Transform3>(
     local: &[Aabb3],
-    xf: &[Affine3A],
+    xf: &[T],
     out: &mut [Aabb3],
     method: Method,
     rounding: Rounding,
 ) -> Result<(), BatchError> {
-    Batch::new(method, rounding).aos(local, xf, out)
+    Batch::new(method, rounding).transform(local, xf, out)
+}
+
+/// Lane helpers shared by the layouts.
+#[inline(always)]
+fn zero_fields<L: LaneArray>() -> [L; crate::transform::MAX_FIELDS] {
+    [L::splat(0.0); crate::transform::MAX_FIELDS]
 }
 
 #[cfg(test)]
 mod tests {
     //! The 16-lane instantiation (the AVX-512 backend's lane type) run without AVX-512:
-    //! every lane does the same arithmetic at any width, so it must reproduce the 8-lane
-    //! backends exactly. This covers the 16-lane code paths (blocks spanning two AoSoA
-    //! blocks, tails, the extended path) on CPUs that cannot run the AVX-512 backend.
+    //! every lane does the same arithmetic at any width, and the tail runs in one lane of
+    //! the same arithmetic, so it must reproduce the 8-lane backends exactly. This covers
+    //! the 16-lane code paths (blocks spanning two AoSoA blocks, tails, the extended path)
+    //! on CPUs that cannot run the AVX-512 backend.
 
     use super::*;
     use crate::simd::F32s;
-    use glam::{Quat, Vec3, Vec3A};
+    use crate::transform::{Rigid3, Trs3};
+    use glam::{Affine3A, Quat, Vec3, Vec3A};
 
-    fn run_lanes<L: LaneArray>(
+    fn run_lanes<L: LaneArray, B: ReadBoxes<3>, X: ReadMaps<3>, O: WriteBoxes<3>>(
         method: Method,
         rounding: Rounding,
-        local: &[Aabb3],
-        xf: &[Affine3A],
-        out: &mut [Aabb3],
+        local: B,
+        xf: X,
+        mut out: O,
     ) {
-        let job: Run<_, _, _, 3> = Run {
+        let len = checked_len(&local, &xf, &mut out).expect("lengths");
+        let run = Run {
             local,
             xf,
             out,
-            len: local.len(),
+            len,
             method,
             rounding,
         };
-        job.run::<L>();
+        RunN::<3, _, _, _>(run).run::<L>();
     }
 
-    fn inputs(n: usize) -> (Vec<Aabb3>, Vec<Affine3A>) {
+    fn inputs(n: usize) -> (Vec<Aabb3>, Vec<Affine3A>, Vec<Trs3>) {
         let specials = [f32::NAN, f32::INFINITY, -f32::INFINITY, 3e38, -0.0, 1e-45];
-        (0..n)
-            .map(|k| {
-                let x = k as f32;
-                let mut b = Aabb3::new(Vec3A::new(-x, 0.5 * x, -1.0), Vec3A::new(x + 1.0, x, 2.0));
-                let mut xf = Affine3A::from_scale_rotation_translation(
-                    Vec3::new(1.0 + x * 0.01, 2.0, 0.5),
-                    Quat::from_rotation_y(x),
-                    Vec3::splat(x * 10.0),
-                );
-                if k % 7 == 3 {
-                    b.min.y = specials[k % specials.len()];
-                }
-                if k % 11 == 5 {
-                    xf.matrix3.y_axis.z = specials[k % specials.len()];
-                }
-                (b, xf)
-            })
-            .unzip()
+        let mut boxes = Vec::new();
+        let mut affines = Vec::new();
+        let mut trs = Vec::new();
+        for k in 0..n {
+            let x = k as f32;
+            let mut b = Aabb3::new(Vec3A::new(-x, 0.5 * x, -1.0), Vec3A::new(x + 1.0, x, 2.0));
+            let scale = Vec3::new(1.0 + x * 0.01, 2.0, -0.5);
+            let q = Quat::from_rotation_y(x);
+            let mut xf = Affine3A::from_scale_rotation_translation(scale, q, Vec3::splat(x * 10.0));
+            let mut t: Trs3 = (scale, q, Vec3::splat(x)).into();
+            if k % 7 == 3 {
+                b.min.y = specials[k % specials.len()];
+            }
+            if k % 11 == 5 {
+                xf.matrix3.y_axis.z = specials[k % specials.len()];
+                t.rotation.z = specials[k % specials.len()];
+            }
+            boxes.push(b);
+            affines.push(xf);
+            trs.push(t);
+        }
+        (boxes, affines, trs)
     }
 
     fn same(a: &[Aabb3], b: &[Aabb3]) -> bool {
         let eq = |x: f32, y: f32| x == y || (x.is_nan() && y.is_nan());
-        a.iter()
-            .zip(b)
-            .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
     }
 
     #[test]
     fn sixteen_lanes_reproduce_eight() {
         for n in [0, 1, 15, 16, 17, 40, 333] {
-            let (local, xf) = inputs(n);
+            let (local, affines, trs) = inputs(n);
+            let rigid: Vec<Rigid3> = trs
+                .iter()
+                .map(|t| Rigid3::new(t.rotation, t.translation))
+                .collect();
             for method in Method::ALL {
                 for rounding in Rounding::ALL {
+                    let (m, r) = (method, rounding);
                     let mut reference = vec![Aabb3::NAN; n];
                     let mut sixteen = vec![Aabb3::NAN; n];
-                    run_lanes::<F32s<8, false>>(method, rounding, &local, &xf, &mut reference);
-                    run_lanes::<F32s<16, false>>(method, rounding, &local, &xf, &mut sixteen);
-                    assert!(same(&reference, &sixteen), "{method:?} {rounding:?} n={n}");
-                    // Fused: `f32::mul_add` is correctly rounded whether or not the
-                    // instruction exists, so both widths must agree here too.
-                    run_lanes::<F32s<8, true>>(method, rounding, &local, &xf, &mut reference);
-                    run_lanes::<F32s<16, true>>(method, rounding, &local, &xf, &mut sixteen);
-                    assert!(
-                        same(&reference, &sixteen),
-                        "{method:?} {rounding:?} n={n} fused"
+                    // Unfused and fused (`f32::mul_add` is correctly rounded whether or not
+                    // the instruction exists, so both widths must agree either way).
+                    run_lanes::<F32s<8, false>, _, _, _>(
+                        m,
+                        r,
+                        &local[..],
+                        &affines[..],
+                        &mut reference[..],
                     );
+                    run_lanes::<F32s<16, false>, _, _, _>(
+                        m,
+                        r,
+                        &local[..],
+                        &affines[..],
+                        &mut sixteen[..],
+                    );
+                    assert!(same(&reference, &sixteen), "{m:?} {r:?} n={n}");
+                    run_lanes::<F32s<8, true>, _, _, _>(
+                        m,
+                        r,
+                        &local[..],
+                        &trs[..],
+                        &mut reference[..],
+                    );
+                    run_lanes::<F32s<16, true>, _, _, _>(
+                        m,
+                        r,
+                        &local[..],
+                        &trs[..],
+                        &mut sixteen[..],
+                    );
+                    assert!(same(&reference, &sixteen), "{m:?} {r:?} n={n} trs fused");
                     // AoSoA blocks, where 16 lanes span two blocks.
-                    let (l8, x8) = (Aabb3x8::pack(&local), Affine3x8::pack(&xf));
-                    let mut o8 = vec![Aabb3x8::EMPTY; l8.len()];
-                    let job: Run<_, _, _, 3> = Run {
-                        local: &l8[..],
-                        xf: &x8[..],
-                        out: &mut o8[..],
-                        len: l8.len() * 8,
-                        method,
-                        rounding,
-                    };
-                    job.run::<F32s<16, true>>();
-                    assert!(
-                        same(&Aabb3x8::unpack(&o8, n), &reference),
-                        "{method:?} {rounding:?} n={n} aosoa"
+                    let (l8, x8) = (Block8::pack(&local), Block8::pack(&rigid));
+                    let mut o8 = vec![Aabb3x8::default(); l8.len()];
+                    run_lanes::<F32s<8, true>, _, _, _>(
+                        m,
+                        r,
+                        &local[..],
+                        &rigid[..],
+                        &mut reference[..],
                     );
+                    run_lanes::<F32s<16, true>, _, _, _>(m, r, &l8[..], &x8[..], &mut o8[..]);
+                    let got: Vec<Aabb3> = Block8::unpack(&o8, n);
+                    assert!(same(&got, &reference), "{m:?} {r:?} n={n} aosoa");
                 }
             }
         }

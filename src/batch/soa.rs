@@ -2,126 +2,172 @@
 
 use glam::Affine3A;
 
-use super::{BatchError, BoxSink, BoxSource, MapSource};
-use crate::aabb::Aabb3;
-use crate::kernel::AffineLanes;
-use crate::lane::{Lane, Vector};
+use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{BatchError, box_lanes, zero_fields};
+use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::lane::Vector;
 use crate::simd::LaneArray;
+use crate::transform::{Class, Fields, MAX_FIELDS};
 
-/// Owned SoA boxes: `min[axis][box]`, `max[axis][box]` (`min[0]` is `min_x`, ...).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct AabbSoa {
-    /// The lower corners, one column per axis.
-    pub min: [Vec<f32>; 3],
-    /// The upper corners, one column per axis.
-    pub max: [Vec<f32>; 3],
+/// Owned columns of values of `T` (boxes or transforms): `columns[n][k]` is field `n` of
+/// value `k`, in the field order of `T` (see [`Block8`](super::Block8)).
+pub struct Soa<T: Fields> {
+    /// One column per field (`[Vec<f32>; F]` for `F` fields).
+    pub columns: T::Array<Vec<f32>>,
 }
 
-/// Borrowed SoA boxes to read; every column must have the same length.
-#[derive(Clone, Copy, Debug)]
-pub struct AabbSoaRef<'a> {
-    /// The lower corners, one column per axis.
-    pub min: [&'a [f32]; 3],
-    /// The upper corners, one column per axis.
-    pub max: [&'a [f32]; 3],
+/// Borrowed columns to read; every column must have the same length.
+pub struct SoaRef<'a, T: Fields> {
+    /// One column per field (`[&[f32]; F]` for `F` fields).
+    pub columns: T::Array<&'a [f32]>,
 }
 
-/// Borrowed SoA boxes to write; every column must have the same length.
-#[derive(Debug)]
-pub struct AabbSoaMut<'a> {
-    /// The lower corners, one column per axis.
-    pub min: [&'a mut [f32]; 3],
-    /// The upper corners, one column per axis.
-    pub max: [&'a mut [f32]; 3],
+/// Borrowed columns to write; every column must have the same length.
+pub struct SoaMut<'a, T: Fields> {
+    /// One column per field (`[&mut [f32]; F]` for `F` fields).
+    pub columns: T::Array<&'a mut [f32]>,
 }
 
-/// Owned SoA transforms: `cols[j][i][k]` is entry `m_ij` of transform `k`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Affine3Soa {
-    /// The columns of the linear parts, one `f32` column per entry.
-    pub cols: [[Vec<f32>; 3]; 3],
-    /// The translations, one column per axis.
-    pub translation: [Vec<f32>; 3],
+/// Owned 3D boxes as columns `min.x, min.y, min.z, max.x, max.y, max.z`.
+pub type AabbSoa = Soa<Aabb3>;
+/// Borrowed 3D box columns to read.
+pub type AabbSoaRef<'a> = SoaRef<'a, Aabb3>;
+/// Borrowed 3D box columns to write.
+pub type AabbSoaMut<'a> = SoaMut<'a, Aabb3>;
+/// Owned 2D boxes as columns `min.x, min.y, max.x, max.y`.
+pub type Aabb2Soa = Soa<Aabb2>;
+/// Borrowed 2D box columns to read.
+pub type Aabb2SoaRef<'a> = SoaRef<'a, Aabb2>;
+/// Borrowed 2D box columns to write.
+pub type Aabb2SoaMut<'a> = SoaMut<'a, Aabb2>;
+/// Owned 3D affine transforms as twelve columns.
+pub type Affine3Soa = Soa<Affine3A>;
+/// Borrowed 3D affine transform columns.
+pub type Affine3SoaRef<'a> = SoaRef<'a, Affine3A>;
+
+impl<T: Fields> Clone for Soa<T> {
+    fn clone(&self) -> Self {
+        Self::from_columns(T::array(|n| self.columns.as_ref()[n].clone()))
+    }
 }
 
-/// Borrowed SoA transforms (twelve columns of the same length).
-#[derive(Clone, Copy, Debug)]
-pub struct Affine3SoaRef<'a> {
-    /// The columns of the linear parts, one `f32` column per entry.
-    pub cols: [[&'a [f32]; 3]; 3],
-    /// The translations, one column per axis.
-    pub translation: [&'a [f32]; 3],
+impl<T: Fields> PartialEq for Soa<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.columns.as_ref() == other.columns.as_ref()
+    }
 }
 
-impl AabbSoa {
-    /// The boxes as columns.
+impl<T: Fields> core::fmt::Debug for Soa<T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Soa")
+            .field("columns", &self.columns.as_ref())
+            .finish()
+    }
+}
+
+impl<T: Fields> Clone for SoaRef<'_, T> {
+    fn clone(&self) -> Self {
+        Self::new(T::array(|n| self.columns.as_ref()[n]))
+    }
+}
+
+impl<'a, T: Fields> Copy for SoaRef<'a, T> where T::Array<&'a [f32]>: Copy {}
+
+impl<T: Fields> core::fmt::Debug for SoaRef<'_, T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SoaRef")
+            .field("columns", &self.columns.as_ref())
+            .finish()
+    }
+}
+
+impl<T: Fields> core::fmt::Debug for SoaMut<'_, T> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SoaMut")
+            .field("columns", &self.columns.as_ref())
+            .finish()
+    }
+}
+
+impl<T: Fields> Soa<T> {
+    /// Columns from their data.
     #[must_use]
-    pub fn from_boxes(boxes: &[Aabb3]) -> Self {
-        Self {
-            min: core::array::from_fn(|a| boxes.iter().map(|b| b.min[a]).collect()),
-            max: core::array::from_fn(|a| boxes.iter().map(|b| b.max[a]).collect()),
-        }
+    pub fn from_columns(columns: T::Array<Vec<f32>>) -> Self {
+        Self { columns }
     }
 
-    /// `len` empty boxes.
+    /// The values as columns.
     #[must_use]
-    pub fn empty(len: usize) -> Self {
-        Self {
-            min: core::array::from_fn(|_| vec![f32::INFINITY; len]),
-            max: core::array::from_fn(|_| vec![f32::NEG_INFINITY; len]),
+    pub fn from_slice(values: &[T]) -> Self {
+        let mut columns = T::array(|_| Vec::with_capacity(values.len()));
+        for v in values {
+            let f = v.to_fields();
+            for (column, x) in columns.as_mut().iter_mut().zip(f) {
+                column.push(x);
+            }
         }
+        Self::from_columns(columns)
     }
 
-    /// Box `k`.
+    /// `len` copies of `value`.
     #[must_use]
-    pub fn get(&self, k: usize) -> Aabb3 {
-        Aabb3::new(
-            self.min.each_ref().map(|c| c[k]).into(),
-            self.max.each_ref().map(|c| c[k]).into(),
-        )
+    pub fn filled(len: usize, value: T) -> Self {
+        let f = value.to_fields();
+        Self::from_columns(T::array(|n| vec![f[n]; len]))
+    }
+
+    /// The number of values (of the first column).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.columns.as_ref().first().map_or(0, Vec::len)
+    }
+
+    /// True when there are no values.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Value `k`.
+    #[must_use]
+    pub fn get(&self, k: usize) -> T {
+        let mut v = [0.0; MAX_FIELDS];
+        for (x, column) in v.iter_mut().zip(self.columns.as_ref()) {
+            *x = column[k];
+        }
+        T::from_fields(&v)
     }
 
     /// A read view.
     #[must_use]
-    pub fn view(&self) -> AabbSoaRef<'_> {
-        AabbSoaRef {
-            min: self.min.each_ref().map(Vec::as_slice),
-            max: self.max.each_ref().map(Vec::as_slice),
-        }
+    pub fn view(&self) -> SoaRef<'_, T> {
+        let columns = self.columns.as_ref();
+        SoaRef::new(T::array(|n| columns[n].as_slice()))
     }
 
     /// A write view.
     #[must_use]
-    pub fn view_mut(&mut self) -> AabbSoaMut<'_> {
-        AabbSoaMut {
-            min: self.min.each_mut().map(Vec::as_mut_slice),
-            max: self.max.each_mut().map(Vec::as_mut_slice),
-        }
+    pub fn view_mut(&mut self) -> SoaMut<'_, T> {
+        let mut columns = self.columns.as_mut().iter_mut();
+        SoaMut::new(T::array(|_| {
+            columns.next().map_or(&mut [][..], Vec::as_mut_slice)
+        }))
     }
 }
 
-impl Affine3Soa {
-    /// The transforms as columns.
+impl<'a, T: Fields> SoaRef<'a, T> {
+    /// A view of borrowed columns, one per field of `T` in its field order.
     #[must_use]
-    pub fn from_affines(xfs: &[Affine3A]) -> Self {
-        Self {
-            cols: core::array::from_fn(|j| {
-                core::array::from_fn(|i| xfs.iter().map(|x| x.matrix3.col(j)[i]).collect())
-            }),
-            translation: core::array::from_fn(|i| xfs.iter().map(|x| x.translation[i]).collect()),
-        }
+    pub fn new(columns: T::Array<&'a [f32]>) -> Self {
+        Self { columns }
     }
+}
 
-    /// A read view.
+impl<'a, T: Fields> SoaMut<'a, T> {
+    /// A view of borrowed columns to write, one per field of `T` in its field order.
     #[must_use]
-    pub fn view(&self) -> Affine3SoaRef<'_> {
-        Affine3SoaRef {
-            cols: self
-                .cols
-                .each_ref()
-                .map(|c| c.each_ref().map(Vec::as_slice)),
-            translation: self.translation.each_ref().map(Vec::as_slice),
-        }
+    pub fn new(columns: T::Array<&'a mut [f32]>) -> Self {
+        Self { columns }
     }
 }
 
@@ -141,50 +187,57 @@ fn common_len(
     }
 }
 
-/// Lanes `i..i + L::WIDTH` of three columns: three vector loads. A function, not a
-/// closure: closures in the loaders were left outlined, which stops vectorisation.
+/// Lanes `i..i + count` of every column: one vector load per column for a whole lane
+/// block, lane by lane for the tail.
 #[inline(always)]
-fn columns<L: LaneArray>(c: &[&[f32]; 3], i: usize) -> Vector<L, 3> {
-    Vector([
-        L::load(&c[0][i..]),
-        L::load(&c[1][i..]),
-        L::load(&c[2][i..]),
-    ])
+fn gather<L: LaneArray, T: Fields>(
+    columns: &T::Array<&[f32]>,
+    i: usize,
+    count: usize,
+) -> [L; MAX_FIELDS] {
+    let columns = columns.as_ref();
+    let mut f = zero_fields::<L>();
+    if count == L::WIDTH {
+        for n in 0..T::FIELDS {
+            f[n] = L::load(&columns[n][i..]);
+        }
+        return f;
+    }
+    for n in 0..T::FIELDS {
+        for k in 0..L::WIDTH {
+            if k < count {
+                f[n].set(k, columns[n][i + k]);
+            }
+        }
+    }
+    f
 }
 
-impl BoxSource<3> for AabbSoaRef<'_> {
+impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
     fn len(&self) -> Result<usize, BatchError> {
         common_len(
             "a column of the local boxes",
-            self.min.iter().chain(&self.max).map(|c| c.len()),
+            self.columns.as_ref().iter().map(|c| c.len()),
         )
     }
     #[inline(always)]
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, 3>, Vector<L, 3>) {
-        if count == L::WIDTH {
-            return (columns(&self.min, i), columns(&self.max, i));
-        }
-        let (mut lo, mut hi) = (Vector::<L, 3>::splat(0.0), Vector::<L, 3>::splat(0.0));
-        for a in 0..3 {
-            for k in 0..L::WIDTH {
-                if k < count {
-                    lo.0[a].set(k, self.min[a][i + k]);
-                    hi.0[a].set(k, self.max[a][i + k]);
-                }
-            }
-        }
-        (lo, hi)
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
+        box_lanes(&gather::<L, B>(&self.columns, i, count))
     }
-    fn get(&self, i: usize) -> ([f32; 3], [f32; 3]) {
-        (self.min.map(|c| c[i]), self.max.map(|c| c[i]))
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
+        let c = self.columns.as_ref();
+        (
+            core::array::from_fn(|a| c[a][i]),
+            core::array::from_fn(|a| c[N + a][i]),
+        )
     }
 }
 
-impl BoxSink<3> for AabbSoaMut<'_> {
-    fn len(&self) -> Result<usize, BatchError> {
+impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
+    fn len(&mut self) -> Result<usize, BatchError> {
         common_len(
             "a column of the output",
-            self.min.iter().chain(&self.max).map(|c| c.len()),
+            self.columns.as_ref().iter().map(|c| c.len()),
         )
     }
     #[inline(always)]
@@ -192,78 +245,113 @@ impl BoxSink<3> for AabbSoaMut<'_> {
         &mut self,
         i: usize,
         count: usize,
-        min: Vector<L, 3>,
-        max: Vector<L, 3>,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
     ) {
+        let columns = self.columns.as_mut();
         if count == L::WIDTH {
-            for a in 0..3 {
-                min.0[a].store(&mut self.min[a][i..]);
-                max.0[a].store(&mut self.max[a][i..]);
+            for a in 0..N {
+                min.0[a].store(&mut columns[a][i..]);
+                max.0[a].store(&mut columns[N + a][i..]);
             }
             return;
         }
-        for a in 0..3 {
+        for a in 0..N {
             for k in 0..L::WIDTH {
                 if k < count {
-                    self.min[a][i + k] = min.0[a].get(k);
-                    self.max[a][i + k] = max.0[a].get(k);
+                    columns[a][i + k] = min.0[a].get(k);
+                    columns[N + a][i + k] = max.0[a].get(k);
                 }
             }
         }
     }
-    fn set(&mut self, i: usize, min: [f32; 3], max: [f32; 3]) {
-        for a in 0..3 {
-            self.min[a][i] = min[a];
-            self.max[a][i] = max[a];
+    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
+        let columns = self.columns.as_mut();
+        for a in 0..N {
+            columns[a][i] = min[a];
+            columns[N + a][i] = max[a];
         }
     }
 }
 
-impl MapSource<3> for Affine3SoaRef<'_> {
-    type Lanes<L: LaneArray> = AffineLanes<Vector<L, 3>, 3>;
+impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
+    type Class = T;
     fn len(&self) -> Option<usize> {
         // A transform column of another length is reported as that length.
-        let mut lens = self
-            .cols
-            .iter()
-            .flatten()
-            .chain(&self.translation)
-            .map(|c| c.len());
-        let first = lens.next().unwrap_or(0);
-        Some(lens.find(|&n| n != first).unwrap_or(first))
+        let columns = self.columns.as_ref();
+        let first = columns.first().map_or(0, |c| c.len());
+        Some(
+            columns
+                .iter()
+                .map(|c| c.len())
+                .find(|&n| n != first)
+                .unwrap_or(first),
+        )
     }
     #[inline(always)]
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> Self::Lanes<L> {
-        if count == L::WIDTH {
-            return AffineLanes {
-                cols: [
-                    columns(&self.cols[0], i),
-                    columns(&self.cols[1], i),
-                    columns(&self.cols[2], i),
-                ],
-                t: columns(&self.translation, i),
-            };
-        }
-        let mut map = AffineLanes {
-            cols: [Vector::<L, 3>::splat(0.0); 3],
-            t: Vector::splat(0.0),
-        };
-        for a in 0..3 {
-            for k in 0..L::WIDTH {
-                if k < count {
-                    for j in 0..3 {
-                        map.cols[j].0[a].set(k, self.cols[j][a][i + k]);
-                    }
-                    map.t.0[a].set(k, self.translation[a][i + k]);
-                }
-            }
-        }
-        map
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
+        T::lanes(&gather::<L, T>(&self.columns, i, count))
     }
-    fn get(&self, i: usize) -> ([[f32; 3]; 3], [f32; 3]) {
-        (
-            self.cols.map(|c| c.map(|row| row[i])),
-            self.translation.map(|row| row[i]),
-        )
+    fn get(&self, i: usize) -> T {
+        let mut v = [0.0; MAX_FIELDS];
+        for (x, column) in v.iter_mut().zip(self.columns.as_ref()) {
+            *x = column[i];
+        }
+        T::from_fields(&v)
+    }
+}
+
+impl<'a, const N: usize, E: Fields> ReadBoxes<N> for &'a Soa<E>
+where
+    SoaRef<'a, E>: ReadBoxes<N>,
+{
+    fn len(&self) -> Result<usize, BatchError> {
+        ReadBoxes::len(&self.view())
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
+        ReadBoxes::load(&self.view(), i, count)
+    }
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
+        ReadBoxes::get(&self.view(), i)
+    }
+}
+
+impl<const N: usize, E: Fields> WriteBoxes<N> for &mut Soa<E>
+where
+    for<'b> SoaMut<'b, E>: WriteBoxes<N>,
+{
+    fn len(&mut self) -> Result<usize, BatchError> {
+        WriteBoxes::len(&mut self.view_mut())
+    }
+    #[inline(always)]
+    fn store<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
+    ) {
+        self.view_mut().store(i, count, min, max);
+    }
+    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
+        self.view_mut().set(i, min, max);
+    }
+}
+
+impl<'a, const N: usize, E: Fields> ReadMaps<N> for &'a Soa<E>
+where
+    SoaRef<'a, E>: ReadMaps<N>,
+{
+    type Class = <SoaRef<'a, E> as ReadMaps<N>>::Class;
+    fn len(&self) -> Option<usize> {
+        ReadMaps::len(&self.view())
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> <Self::Class as Class<N>>::Lanes<L> {
+        ReadMaps::load(&self.view(), i, count)
+    }
+    fn get(&self, i: usize) -> Self::Class {
+        ReadMaps::get(&self.view(), i)
     }
 }

@@ -10,9 +10,12 @@ use core::ops::{Add, Mul, Neg, Sub};
 use crate::lane::Lane;
 
 /// A lane type whose lanes can be built, read and written one at a time.
-pub(crate) trait LaneArray: Lane {
+pub trait LaneArray: Lane {
     /// The number of lanes.
     const WIDTH: usize;
+    /// One lane with the same arithmetic (fused exactly when `Self` fuses): the lane type
+    /// of the last, partial block, so that every box is rounded the same wherever it sits.
+    type One: LaneArray;
     /// Lane `k`.
     fn get(&self, k: usize) -> f32;
     /// Sets lane `k`.
@@ -27,6 +30,7 @@ pub(crate) trait LaneArray: Lane {
 
 impl LaneArray for f32 {
     const WIDTH: usize = 1;
+    type One = f32;
     #[inline(always)]
     fn get(&self, _: usize) -> f32 {
         *self
@@ -53,7 +57,7 @@ impl LaneArray for f32 {
 /// enclosing function enables the FMA instructions).
 #[derive(Clone, Copy, Debug)]
 #[repr(transparent)]
-pub(crate) struct F32s<const W: usize, const FMA: bool>(pub [f32; W]);
+pub struct F32s<const W: usize, const FMA: bool>(pub [f32; W]);
 
 impl<const W: usize, const FMA: bool> F32s<W, FMA> {
     // Plain indexed loops rather than `array::from_fn`/`map`: their closures and
@@ -151,6 +155,7 @@ impl<const W: usize, const FMA: bool> Lane for F32s<W, FMA> {
 
 impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
     const WIDTH: usize = W;
+    type One = F32s<1, FMA>;
     #[inline(always)]
     fn get(&self, k: usize) -> f32 {
         self.0[k]
@@ -210,6 +215,7 @@ impl Lane for wide::f32x8 {
 
 impl LaneArray for wide::f32x8 {
     const WIDTH: usize = 8;
+    type One = F32s<1, { cfg!(target_feature = "fma") }>;
     #[inline(always)]
     fn get(&self, k: usize) -> f32 {
         self.as_array()[k]

@@ -5,7 +5,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 
-use super::oracle::Problem;
+use super::oracle::{Problem, QuatProblem};
 
 /// The classes of input the contract is tested over.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -341,4 +341,175 @@ pub fn rigid_problem(class: Class, rng: &mut StdRng) -> Problem<2> {
         cols: rigid_cols(cos, sin),
         ..p
     }
+}
+
+/// Which scale a quaternion problem carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// `[1, 1, 1]`: a rigid pose.
+    Unit,
+    /// `[σ, σ, σ]`: a similarity.
+    Uniform,
+    /// Any per-axis scale: a scale-rotation-translation.
+    PerAxis,
+}
+
+/// A random unit quaternion `[x, y, z, w]`, rounded to `f32` (so a few ulps off unit).
+fn unit_quat(rng: &mut StdRng) -> [f32; 4] {
+    loop {
+        let q: [f64; 4] = core::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let n = q.iter().map(|v| v * v).sum::<f64>();
+        if n > 1e-3 && n <= 1.0 {
+            return q.map(|v| (v / n.sqrt()) as f32);
+        }
+    }
+}
+
+/// A quaternion problem of the given extreme class: the box and translation of the class's
+/// affine problem, a rotation and a scale bent the same way.
+pub fn quat_problem(class: Class, scale: Scale, rng: &mut StdRng) -> QuatProblem {
+    let p = problem::<3>(class, rng);
+    bend_quat(p, class, scale, rng)
+}
+
+/// The quaternion problem on the box and translation of `p`, bent by `class`.
+pub fn bend_quat(p: Problem<3>, class: Class, scale: Scale, rng: &mut StdRng) -> QuatProblem {
+    let mut q = unit_quat(rng);
+    let mut s = match scale {
+        Scale::Unit => [1.0; 3],
+        Scale::Uniform => [rng.random_range(0.1..10.0) * sign(rng); 3],
+        Scale::PerAxis => core::array::from_fn(|_| rng.random_range(0.1..10.0) * sign(rng)),
+    };
+    let mut t = p.t;
+    // The scale a class may bend: per axis, or all three together.
+    let bend = |s: &mut [f32; 3], rng: &mut StdRng, f: &dyn Fn(&mut StdRng) -> f32| match scale {
+        Scale::Unit => {}
+        Scale::Uniform => *s = [f(rng); 3],
+        Scale::PerAxis => *s = core::array::from_fn(|_| f(rng)),
+    };
+    match class {
+        Class::Typical | Class::Far | Class::ZeroSize | Class::Empty => {}
+        Class::NearMax => {
+            // Far from unit: R(q) entries up to ~1e37, or a huge scale.
+            if rng.random_bool(0.5) {
+                let k = 10f32.powf(rng.random_range(10.0..18.5));
+                q = q.map(|c| c * k);
+            }
+            bend(&mut s, rng, &|r| log_uniform(r, 30.0, 38.0));
+        }
+        Class::Subnormal => {
+            if rng.random_bool(0.5) {
+                q = core::array::from_fn(|_| subnormal(rng));
+            }
+            bend(&mut s, rng, &|r| subnormal(r));
+        }
+        Class::Reflection => {
+            q = q.map(|c| -c); // the same rotation, every sign flipped
+            bend(&mut s, rng, &|r| -r.random_range(0.1..10.0));
+        }
+        Class::Shear | Class::Drifted => {
+            // Off unit length: a little (drifted) or a lot (the formula is then no rotation).
+            let k = if class == Class::Drifted {
+                1.0 + rng.random_range(-1e-2..1e-2)
+            } else {
+                10f32.powf(rng.random_range(-3.0..3.0))
+            };
+            q = q.map(|c| c * k);
+        }
+        Class::NearSingular => {
+            if rng.random_bool(0.3) {
+                q = [0.0; 4]; // the zero quaternion: R = I
+            }
+            bend(&mut s, rng, &|r| match r.random_range(0..4) {
+                0 => 0.0,
+                1 => log_uniform(r, -8.0, -5.0),
+                2 => log_uniform(r, 5.0, 8.0),
+                _ => 1.0,
+            });
+        }
+        Class::QuarterTurn => {
+            // Quarter and half turns: components in {0, ±1/2, ±√½, ±1}, plus noise.
+            let h = core::f32::consts::FRAC_1_SQRT_2;
+            let choices = [
+                [0.0, 0.0, 0.0, 1.0],
+                [h, 0.0, 0.0, h],
+                [0.0, h, 0.0, h],
+                [0.0, 0.0, h, h],
+                [0.5, 0.5, 0.5, 0.5],
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, h, h, 0.0],
+            ];
+            q = choices[rng.random_range(0..choices.len())];
+            for c in &mut q {
+                *c *= sign(rng);
+                if *c == 0.0 && rng.random_bool(0.3) {
+                    *c = 10f32.powf(rng.random_range(-8.0..-6.0)) * sign(rng);
+                }
+            }
+        }
+        Class::SignedZero => {
+            for c in &mut q {
+                if rng.random_bool(0.3) {
+                    *c = 0.0 * sign(rng);
+                }
+            }
+            bend(&mut s, rng, &|r| {
+                if r.random_bool(0.5) {
+                    0.0 * sign(r)
+                } else {
+                    1.0
+                }
+            });
+        }
+        Class::Unbounded => {
+            if rng.random_bool(0.5) {
+                q = [[0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.0]][rng.random_range(0..2)];
+            }
+        }
+        Class::Nan => {
+            let k = rng.random_range(0..7);
+            if k < 4 {
+                q[k] = f32::NAN;
+            } else if scale != Scale::Unit && k < 6 {
+                s = [f32::NAN; 3];
+            } else {
+                t[rng.random_range(0..3)] = f32::NAN;
+            }
+            if rng.random_bool(0.3) {
+                // An infinity in the map instead.
+                q = [f32::INFINITY, 0.0, 0.0, 1.0];
+            }
+        }
+        Class::RandomBits => {
+            q = core::array::from_fn(|_| random_bits(rng));
+            bend(&mut s, rng, &|r| random_bits(r));
+        }
+    }
+    QuatProblem {
+        q,
+        s,
+        t,
+        lo: p.lo,
+        hi: p.hi,
+    }
+}
+
+/// A translation problem of the given class: the identity matrix, the class's box and
+/// translation.
+pub fn translation_problem<const N: usize>(class: Class, rng: &mut StdRng) -> Problem<N> {
+    as_translation(problem::<N>(class, rng))
+}
+
+/// The translation problem on the box and translation of `p`.
+pub fn as_translation<const N: usize>(p: Problem<N>) -> Problem<N> {
+    let mut cols = [[0.0; N]; N];
+    for (j, col) in cols.iter_mut().enumerate() {
+        col[j] = 1.0;
+    }
+    // The class's NaN may have gone into the matrix: move it to the translation.
+    let mut t = p.t;
+    if p.cols.iter().flatten().any(|x| x.is_nan()) {
+        t[0] = f32::NAN;
+    }
+    Problem { cols, t, ..p }
 }

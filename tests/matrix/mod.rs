@@ -4,13 +4,18 @@
 //! writes it to `docs/STABILITY.md`.
 #![allow(dead_code)]
 
-use bvkit::{Aabb2, Aabb3, Aabb3x8, Affine3x8, Backend, Batch, Method, Rigid2, Rounding};
-use glam::{Affine2, Affine3A, Mat2, Vec2, Vec3A};
+use bvkit::{
+    Aabb2, Aabb3, Aabb3x8, Backend, Batch, Block8, Method, Rounding, Transform2, Transform3,
+    Translation2, Translation3,
+};
+use glam::{Vec2, Vec3A};
 use rand::RngExt;
 use rand::rngs::StdRng;
 
-use super::cases::{Class, problem, rng};
-use super::oracle::{Bound, Expected, Problem, affine3, check};
+use super::cases::{Class, Scale, as_translation, bend_quat, problem, rng};
+use super::oracle::{
+    Bound, Exactly, Expected, Problem, QuatProblem, affine2, affine3, check, rigid2,
+};
 
 /// Cases per cell.
 pub const CASES: u64 = 400;
@@ -42,48 +47,52 @@ fn huge_scale(r: &mut StdRng) -> Problem<3> {
     p
 }
 
-/// Rows of the matrix, in the order of the list.
-pub fn rows() -> Vec<(&'static str, Generator)> {
+/// Rows of the matrix, in the order of the list: the name, the generator of the
+/// affine problems, and the class that bends the quaternion classes' rotation and scale.
+pub fn rows() -> Vec<(&'static str, Generator, Class)> {
+    let class_row = |name, class| (name, Box::new(from_class(class)) as Generator, class);
     vec![
-        ("far: t = ±1e3", Box::new(|r: &mut StdRng| far(r, 3))),
-        ("far: t = ±1e5", Box::new(|r: &mut StdRng| far(r, 5))),
-        ("far: t = ±1e7", Box::new(|r: &mut StdRng| far(r, 7))),
-        ("far: t = ±1e9", Box::new(|r: &mut StdRng| far(r, 9))),
         (
-            "near f32::MAX (overflow included)",
-            Box::new(from_class(Class::NearMax)),
+            "far: t = ±1e3",
+            Box::new(|r: &mut StdRng| far(r, 3)),
+            Class::Typical,
         ),
         (
-            "subnormal boxes and matrices",
-            Box::new(from_class(Class::Subnormal)),
-        ),
-        ("zero-size boxes", Box::new(from_class(Class::ZeroSize))),
-        ("±0.0", Box::new(from_class(Class::SignedZero))),
-        (
-            "90° rotations + tiny noise",
-            Box::new(from_class(Class::QuarterTurn)),
+            "far: t = ±1e5",
+            Box::new(|r: &mut StdRng| far(r, 5)),
+            Class::Typical,
         ),
         (
-            "rotations drifted off orthonormal",
-            Box::new(from_class(Class::Drifted)),
+            "far: t = ±1e7",
+            Box::new(|r: &mut StdRng| far(r, 7)),
+            Class::Typical,
         ),
-        ("reflections", Box::new(from_class(Class::Reflection))),
         (
-            "near-singular scale",
-            Box::new(from_class(Class::NearSingular)),
+            "far: t = ±1e9",
+            Box::new(|r: &mut StdRng| far(r, 9)),
+            Class::Typical,
         ),
-        ("huge scale (1e15–1e30)", Box::new(huge_scale)),
-        ("shear", Box::new(from_class(Class::Shear))),
-        ("unbounded faces", Box::new(from_class(Class::Unbounded))),
+        class_row("near f32::MAX (overflow included)", Class::NearMax),
+        class_row("subnormal boxes and matrices", Class::Subnormal),
+        class_row("zero-size boxes", Class::ZeroSize),
+        class_row("±0.0", Class::SignedZero),
+        class_row("90° rotations + tiny noise", Class::QuarterTurn),
+        class_row("rotations drifted off orthonormal", Class::Drifted),
+        class_row("reflections (negative scale)", Class::Reflection),
+        class_row(
+            "near-singular or zero scale (zero quaternion)",
+            Class::NearSingular,
+        ),
         (
-            "EMPTY and inverted boxes",
-            Box::new(from_class(Class::Empty)),
+            "huge scale (1e15–1e30)",
+            Box::new(huge_scale),
+            Class::NearMax,
         ),
-        ("NaN anywhere", Box::new(from_class(Class::Nan))),
-        (
-            "random bit patterns",
-            Box::new(from_class(Class::RandomBits)),
-        ),
+        class_row("shear (quaternions far from unit)", Class::Shear),
+        class_row("unbounded faces", Class::Unbounded),
+        class_row("EMPTY and inverted boxes", Class::Empty),
+        class_row("NaN anywhere (infinite quaternion)", Class::Nan),
+        class_row("random bit patterns", Class::RandomBits),
     ]
 }
 
@@ -113,7 +122,7 @@ pub struct Cell {
 impl Cell {
     fn add<const N: usize>(
         &mut self,
-        p: &Problem<N>,
+        p: &impl Exactly<N>,
         min: [f32; N],
         max: [f32; N],
         bound: Bound,
@@ -176,80 +185,141 @@ fn planar(p: &Problem<3>) -> Problem<2> {
     }
 }
 
-/// The three transform classes of the tables.
-pub const TABLES: [&str; 3] = ["3D affine", "2D affine", "2D rigid"];
+/// The transform classes of the tables.
+pub const TABLES: [&str; 8] = [
+    "3D affine (Affine3A)",
+    "3D translation (Translation3)",
+    "3D rigid (Rigid3)",
+    "3D similarity (Similarity3)",
+    "3D scale-rotation-translation (Trs3)",
+    "2D affine (Affine2)",
+    "2D rigid (Rigid2)",
+    "2D translation (Translation2)",
+];
 
-/// Computes the matrix: `cells[table][row][kernel]`. Every 3D cell covers the single-box
-/// SIMD and scalar paths and the AoSoA batch on every supported backend; the 2D cells the
-/// single-box path and the AoS batch on every supported backend.
+/// One 3D class's cell: the single-box SIMD and scalar paths and the AoSoA batch on every
+/// supported backend.
+fn cell3<T: Transform3, P: Exactly<3>>(
+    cell: &mut Cell,
+    ps: &[P],
+    inputs: impl Fn(&P) -> (Aabb3, T),
+    method: Method,
+    rounding: Rounding,
+) {
+    let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+    let (local, xfs): (Vec<Aabb3>, Vec<T>) = ps.iter().map(inputs).unzip();
+    for (k, p) in ps.iter().enumerate() {
+        let o = local[k].transformed(&xfs[k], method, rounding);
+        cell.add(p, o.min.to_array(), o.max.to_array(), bound, "single simd");
+        let o = local[k].transformed_scalar(&xfs[k], method, rounding);
+        cell.add(
+            p,
+            o.min.to_array(),
+            o.max.to_array(),
+            bound,
+            "single scalar",
+        );
+    }
+    let (lb, xb) = (Block8::pack(&local), Block8::pack(&xfs));
+    for backend in Backend::supported() {
+        let batch = Batch::new(method, rounding).on(backend).expect("supported");
+        let mut ob = vec![Aabb3x8::default(); lb.len()];
+        batch.transform(&lb, &xb, &mut ob).expect("lengths match");
+        for (p, o) in ps.iter().zip(Block8::unpack(&ob, ps.len())) {
+            let what = format!("aosoa {backend:?}");
+            cell.add(p, o.min.to_array(), o.max.to_array(), bound, &what);
+        }
+    }
+}
+
+/// One 2D class's cell: the single-box path and the AoS batch on every supported backend.
+fn cell2<T: Transform2>(
+    cell: &mut Cell,
+    ps: &[Problem<2>],
+    inputs: impl Fn(&Problem<2>) -> (Aabb2, T),
+    method: Method,
+    rounding: Rounding,
+) {
+    let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+    let (local, xfs): (Vec<Aabb2>, Vec<T>) = ps.iter().map(inputs).unzip();
+    for (k, p) in ps.iter().enumerate() {
+        let o = local[k].transformed(&xfs[k], method, rounding);
+        cell.add(p, o.min.to_array(), o.max.to_array(), bound, "single");
+    }
+    for backend in Backend::supported() {
+        let batch = Batch::new(method, rounding).on(backend).expect("supported");
+        let mut out = vec![Aabb2::NAN; local.len()];
+        batch
+            .transform(&local, &xfs, &mut out)
+            .expect("lengths match");
+        for (p, o) in ps.iter().zip(&out) {
+            let what = format!("aos {backend:?}");
+            cell.add(p, o.min.to_array(), o.max.to_array(), bound, &what);
+        }
+    }
+}
+
+/// Computes the matrix: `cells[table][row][kernel]`.
 pub fn compute() -> Vec<Vec<Vec<Cell>>> {
     let rows = rows();
     let kernels = kernels();
     let mut cells = vec![vec![vec![Cell::default(); kernels.len()]; rows.len()]; TABLES.len()];
-    for (ri, (_, make)) in rows.iter().enumerate() {
+    for (ri, (_, make, class)) in rows.iter().enumerate() {
         let r = &mut rng(0x57ab ^ ri as u64);
         let ps: Vec<Problem<3>> = (0..CASES).map(|_| make(r)).collect();
+        let translations: Vec<Problem<3>> = ps.iter().map(|p| as_translation(*p)).collect();
+        let quats = |scale, r: &mut StdRng| -> Vec<QuatProblem> {
+            ps.iter().map(|p| bend_quat(*p, *class, scale, r)).collect()
+        };
+        let (rigid3, similarity3, trs3) = (
+            quats(Scale::Unit, r),
+            quats(Scale::Uniform, r),
+            quats(Scale::PerAxis, r),
+        );
         let ps2: Vec<Problem<2>> = ps.iter().map(planar).collect();
-        let rigid: Vec<Problem<2>> = ps2
+        let rigid2s: Vec<Problem<2>> = ps2
             .iter()
             .map(|p| Problem {
                 cols: [[p.cols[0][0], p.cols[0][1]], [-p.cols[0][1], p.cols[0][0]]],
                 ..*p
             })
             .collect();
-        let (local, xfs): (Vec<Aabb3>, Vec<Affine3A>) = ps.iter().map(affine3).unzip();
-        let (l8, x8) = (Aabb3x8::pack(&local), Affine3x8::pack(&xfs));
-        let l2: Vec<Aabb2> = ps2
-            .iter()
-            .map(|p| Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)))
-            .collect();
-        let a2: Vec<Affine2> = ps2
-            .iter()
-            .map(|p| {
-                Affine2::from_mat2_translation(
-                    Mat2::from_cols(p.cols[0].into(), p.cols[1].into()),
-                    p.t.into(),
-                )
-            })
-            .collect();
-        let r2: Vec<Rigid2> = rigid
-            .iter()
-            .map(|p| Rigid2::new(p.cols[0][0], p.cols[0][1], p.t.into()))
-            .collect();
-        for (ki, &(method, rounding)) in kernels.iter().enumerate() {
-            let (b3, b2) = (
-                Bound::documented(method, rounding, 3),
-                Bound::documented(method, rounding, 2),
+        let translations2: Vec<Problem<2>> = ps2.iter().map(|p| as_translation(*p)).collect();
+        for (ki, &(m, rd)) in kernels.iter().enumerate() {
+            cell3(&mut cells[0][ri][ki], &ps, affine3, m, rd);
+            let translation = |p: &Problem<3>| {
+                let (b, _) = affine3(p);
+                (b, Translation3(Vec3A::from_array(p.t)))
+            };
+            cell3(&mut cells[1][ri][ki], &translations, translation, m, rd);
+            cell3(
+                &mut cells[2][ri][ki],
+                &rigid3,
+                |p| (p.aabb(), p.rigid3()),
+                m,
+                rd,
             );
-            for (k, p) in ps.iter().enumerate() {
-                let (b, xf) = (local[k], xfs[k]);
-                let o = b.transformed(&xf, method, rounding);
-                cells[0][ri][ki].add(p, o.min.to_array(), o.max.to_array(), b3, "single simd");
-                let o = b.transformed_scalar(&xf, method, rounding);
-                cells[0][ri][ki].add(p, o.min.to_array(), o.max.to_array(), b3, "single scalar");
-                let o = l2[k].transformed(&a2[k], method, rounding);
-                cells[1][ri][ki].add(&ps2[k], o.min.to_array(), o.max.to_array(), b2, "single");
-                let o = l2[k].transformed_rigid(&r2[k], method, rounding);
-                cells[2][ri][ki].add(&rigid[k], o.min.to_array(), o.max.to_array(), b2, "single");
-            }
-            for backend in Backend::supported() {
-                let batch = Batch::new(method, rounding).on(backend).expect("supported");
-                let what = format!("batch {backend:?}");
-                let mut o8 = vec![Aabb3x8::EMPTY; l8.len()];
-                batch.aosoa(&l8, &x8, &mut o8).expect("lengths match");
-                for (p, o) in ps.iter().zip(Aabb3x8::unpack(&o8, ps.len())) {
-                    cells[0][ri][ki].add(p, o.min.to_array(), o.max.to_array(), b3, &what);
-                }
-                let mut o2 = vec![Aabb2::NAN; l2.len()];
-                batch.aos2(&l2, &a2, &mut o2).expect("lengths match");
-                for (p, o) in ps2.iter().zip(&o2) {
-                    cells[1][ri][ki].add(p, o.min.to_array(), o.max.to_array(), b2, &what);
-                }
-                batch.aos_rigid2(&l2, &r2, &mut o2).expect("lengths match");
-                for (p, o) in rigid.iter().zip(&o2) {
-                    cells[2][ri][ki].add(p, o.min.to_array(), o.max.to_array(), b2, &what);
-                }
-            }
+            cell3(
+                &mut cells[3][ri][ki],
+                &similarity3,
+                |p| (p.aabb(), p.similarity3()),
+                m,
+                rd,
+            );
+            cell3(
+                &mut cells[4][ri][ki],
+                &trs3,
+                |p| (p.aabb(), p.trs3()),
+                m,
+                rd,
+            );
+            cell2(&mut cells[5][ri][ki], &ps2, affine2, m, rd);
+            cell2(&mut cells[6][ri][ki], &rigid2s, rigid2, m, rd);
+            let translation2 = |p: &Problem<2>| {
+                let (b, _) = affine2(p);
+                (b, Translation2(Vec2::from_array(p.t)))
+            };
+            cell2(&mut cells[7][ri][ki], &translations2, translation2, m, rd);
         }
     }
     cells
@@ -272,6 +342,7 @@ pub fn mat4_cases() -> Vec<(&'static str, &'static str, String, bool)> {
     let mut nan = Mat4::from_translation(Vec3::ONE);
     nan.y_axis.y = f32::NAN;
     let shift = Mat4::from_translation(Vec3::X);
+    use glam::Affine3A;
     let (m, r) = (Method::SignSelect, Rounding::Outward);
     let affine = unit.try_transformed_mat4(&shift, m, r);
     let projected = in_front.transformed_projective(&proj);
@@ -351,7 +422,7 @@ pub fn markdown(cells: &[Vec<Vec<Cell>>]) -> String {
     let mut s = String::new();
     writeln!(s, "# bvkit stability matrix\n").unwrap();
     writeln!(s, "Generated by `cargo run --release --example stability`; do not edit by hand. `cargo test --test stability` asserts every cell.\n").unwrap();
-    writeln!(s, "Each cell: {CASES} seeded cases of the row's class through the column's kernel on every path (3D: single-box SIMD and scalar, AoSoA batch on every backend this CPU supports; 2D: single box and AoS batch on every backend), each checked against the contract by the exact oracle. `✓` means no case broke the contract; then: worst face error in units of u·S over the finite cases, mean volume overhead over the exact box, the share of results containing the exact box, and how many cases correctly gave `EMPTY` or an invalid (NaN) box. Bounds: Nearest `γ(n)·S + 2^-148`, Outward contains and stays within `2·(k·u·S + 2^-146)`; see `bvkit::method`.\n").unwrap();
+    writeln!(s, "Each cell: {CASES} seeded cases of the row's class through the column's kernel on every path (3D: single-box SIMD and scalar, AoSoA batch on every backend this CPU supports; 2D: single box and AoS batch on every backend), each checked against the contract by the exact oracle. `✓` means no case broke the contract; then: worst face error in units of u·S over the finite cases, mean volume overhead over the exact box, the share of results containing the exact box, and how many cases correctly gave `EMPTY` or an invalid (NaN) box. Bounds: Nearest `γ(n)·S + τ·2^-148`, Outward contains and stays within `2·(k·u·S + τ·2^-146)`, with `n`, `k = n + 2`, `S` and `τ` per class as `bvkit::transform` documents (for the quaternion classes `S` and `τ` carry `ρ = 1 + 2‖q‖²`; worst errors are in units of that `u·S`). The quaternion tables bend the rotation and scale with the row's class as the row names say.\n").unwrap();
     writeln!(
         s,
         "Backends exercised on the machine that generated this file: {:?}.\n",
@@ -366,7 +437,7 @@ pub fn markdown(cells: &[Vec<Vec<Cell>>]) -> String {
         }
         writeln!(s).unwrap();
         writeln!(s, "|---|{}", "---|".repeat(kernels.len())).unwrap();
-        for (ri, (name, _)) in rows.iter().enumerate() {
+        for (ri, (name, _, _)) in rows.iter().enumerate() {
             write!(s, "| {name} |").unwrap();
             for cell in &cells[ti][ri] {
                 write!(s, " {} |", cell.text()).unwrap();

@@ -1,22 +1,24 @@
 //! The exact oracle: error-free arithmetic on the `f32` inputs.
 //!
-//! Every finite `f32` is an integer multiple of `2^-149`, so every product of two is a
-//! multiple of `2^-298`; scaled by `2^298`, the exact faces of a transformed box are
-//! integers, summed here without rounding in arbitrary precision. Containment is decided
-//! by exact comparison; errors are measured as exact differences, converted to `f64` only
-//! for reporting against a bound.
+//! Every finite `f32` is an integer multiple of `2^-149`, so every product of up to four
+//! is a multiple of `2^-596`; scaled by `2^600`, the exact faces of a transformed box are
+//! integers, summed here without rounding in arbitrary precision. That covers the affine
+//! maps (a matrix entry times a coordinate) and the quaternion classes (`R(q)` is a sum
+//! of products of two components, times a scale, times a coordinate). Containment is
+//! decided by exact comparison; errors are measured as exact differences, converted to
+//! `f64` only for reporting against a bound.
 #![allow(dead_code, clippy::needless_range_loop)]
 
 use bvkit::method::{TINY_ERROR, TINY_PAD};
-use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
-use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
+use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rigid3, Rounding, Similarity3, Trs3};
+use glam::{Affine2, Affine3A, Mat2, Mat3A, Quat, Vec2, Vec3A};
 use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
 
 /// The exponent of the fixed-point scale: exact values are `integer · 2^-SCALE`.
-const SCALE: i32 = 298;
+const SCALE: i32 = 600;
 
-/// An exact extended real: `±inf` or `integer · 2^-298`.
+/// An exact extended real: `±inf` or `integer · 2^-600`.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Exact {
     NegInf,
@@ -98,6 +100,48 @@ impl Exact {
         }
     }
 
+    /// The exact product `self · x` (`0 · ±inf = 0`), for finite `self` that is a product
+    /// of at most three `f32` values (so that the result is a multiple of `2^-600`).
+    pub fn mul_f32(&self, x: f32) -> Exact {
+        assert!(!x.is_nan(), "the oracle takes no NaN");
+        let Exact::Finite(a) = self else {
+            panic!("mul_f32 takes a finite value")
+        };
+        if a.is_zero() || x == 0.0 {
+            return Exact::ZERO;
+        }
+        if x.is_infinite() {
+            return if (a.is_negative()) != (x < 0.0) {
+                Exact::NegInf
+            } else {
+                Exact::PosInf
+            };
+        }
+        let (sx, ex) = decompose(x);
+        let p = a * BigInt::from(sx);
+        if ex >= 0 {
+            Exact::Finite(p << ex as usize)
+        } else {
+            let shift = (-ex) as usize;
+            assert!((&p >> shift) << shift == p, "product below 2^-600");
+            Exact::Finite(p >> shift)
+        }
+    }
+
+    /// `2 · self` (finite).
+    pub fn double(&self) -> Exact {
+        self.add(self)
+    }
+
+    /// `−self`.
+    pub fn neg(&self) -> Exact {
+        match self {
+            Exact::Finite(a) => Exact::Finite(-a),
+            Exact::PosInf => Exact::NegInf,
+            Exact::NegInf => Exact::PosInf,
+        }
+    }
+
     /// The nearest `f64` (for reporting; `±inf` stays infinite).
     pub fn to_f64(&self) -> f64 {
         match self {
@@ -123,7 +167,8 @@ impl Exact {
     }
 }
 
-/// A box `[lo, hi]` and an affine map `x ↦ M x + t` with `cols[j][i] = m_ij`.
+/// A box `[lo, hi]` and an affine map `x ↦ M x + t` with `cols[j][i] = m_ij` (a
+/// translation is the identity matrix).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Problem<const N: usize> {
     pub cols: [[f32; N]; N],
@@ -132,10 +177,21 @@ pub struct Problem<const N: usize> {
     pub hi: [f32; N],
 }
 
+/// A box `[lo, hi]` and a quaternion map `x ↦ R(q)·(s ∘ x) + t`, `R(q)` the standard
+/// formula evaluated exactly on the stored components (`q = [x, y, z, w]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuatProblem {
+    pub q: [f32; 4],
+    pub s: [f32; 3],
+    pub t: [f32; 3],
+    pub lo: [f32; 3],
+    pub hi: [f32; 3],
+}
+
 /// What the contract demands of a result.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expected<const N: usize> {
-    /// NaN input or a non-finite matrix: an invalid (NaN) box.
+    /// NaN input or a non-finite map: an invalid (NaN) box.
     Invalid,
     /// An empty box: exactly `EMPTY`.
     Empty,
@@ -147,61 +203,190 @@ pub enum Expected<const N: usize> {
     },
 }
 
-impl<const N: usize> Problem<N> {
-    fn values(&self) -> impl Iterator<Item = f32> + '_ {
-        self.cols
-            .iter()
-            .flatten()
-            .chain(&self.t)
-            .chain(&self.lo)
-            .chain(&self.hi)
-            .copied()
-    }
+/// A problem the oracle can judge: a box and a map whose exact image it computes.
+pub trait Exactly<const N: usize>: core::fmt::Debug {
+    fn lo(&self) -> [f32; N];
+    fn hi(&self) -> [f32; N];
+    fn t(&self) -> [f32; N];
+    /// Every parameter of the map (matrix or quaternion, scale, translation).
+    fn map_values(&self) -> Vec<f32>;
+    /// The exact matrix, `cols[j][i] = m_ij` (finite map parameters).
+    fn exact_cols(&self) -> [[Exact; N]; N];
+    /// The matrix in `f64`, and a bound on the error of every entry of each column.
+    fn approx_cols(&self) -> ([[f64; N]; N], [f64; N]);
+    /// The weight `μ_ij` of `max(|lo_j|, |hi_j|)` in the documented magnitude `S_i`.
+    fn weights(&self) -> [[f64; N]; N];
+    /// The factor `τ` of the absolute terms (`τ·TINY_ERROR`, `τ·TINY_PAD`).
+    fn tau(&self) -> f64;
+    /// The same map with another box.
+    fn with_box(&self, lo: [f32; N], hi: [f32; N]) -> Self
+    where
+        Self: Sized;
 
     /// True when the box holds no real point.
-    pub fn is_empty(&self) -> bool {
-        (0..N).any(|j| {
-            self.lo[j] > self.hi[j]
-                || self.lo[j] == f32::INFINITY
-                || self.hi[j] == f32::NEG_INFINITY
-        })
+    fn is_empty(&self) -> bool {
+        let (lo, hi) = (self.lo(), self.hi());
+        (0..N).any(|j| lo[j] > hi[j] || lo[j] == f32::INFINITY || hi[j] == f32::NEG_INFINITY)
+    }
+
+    /// True when every input is finite.
+    fn all_finite(&self) -> bool {
+        self.map_values()
+            .into_iter()
+            .chain(self.lo())
+            .chain(self.hi())
+            .all(f32::is_finite)
     }
 
     /// What the contract demands, decided exactly.
-    pub fn expected(&self) -> Expected<N> {
-        let matrix_finite = self
-            .cols
-            .iter()
-            .flatten()
-            .chain(&self.t)
-            .all(|x| x.is_finite());
-        if self.values().any(f32::is_nan) || !matrix_finite {
+    fn expected(&self) -> Expected<N> {
+        let (lo_in, hi_in, t) = (self.lo(), self.hi(), self.t());
+        let map = self.map_values();
+        let any_nan = map.iter().chain(&lo_in).chain(&hi_in).any(|x| x.is_nan());
+        if any_nan || !map.iter().all(|x| x.is_finite()) {
             return Expected::Invalid;
         }
         if self.is_empty() {
             return Expected::Empty;
         }
+        let cols = self.exact_cols();
+        let weights = self.weights();
         let mut lo = core::array::from_fn(|_| Exact::ZERO);
         let mut hi = core::array::from_fn(|_| Exact::ZERO);
         let mut magnitude = [0.0; N];
         for i in 0..N {
-            let (mut l, mut h) = (Exact::of(self.t[i]), Exact::of(self.t[i]));
-            let mut s = Exact::of(self.t[i]).abs();
+            let (mut l, mut h) = (Exact::of(t[i]), Exact::of(t[i]));
+            let mut s = f64::from(t[i]).abs();
             for j in 0..N {
-                let m = self.cols[j][i];
-                let a = Exact::product(m, self.lo[j]);
-                let b = Exact::product(m, self.hi[j]);
-                let reach = a.abs().max(b.abs());
+                let a = cols[j][i].mul_f32(lo_in[j]);
+                let b = cols[j][i].mul_f32(hi_in[j]);
                 let (low, high) = if a <= b { (a, b) } else { (b, a) };
                 l = l.add(&low);
                 h = h.add(&high);
-                s = s.add(&reach);
+                let reach = f64::from(lo_in[j]).abs().max(f64::from(hi_in[j]).abs());
+                if weights[i][j] != 0.0 {
+                    s += weights[i][j] * reach;
+                }
             }
             lo[i] = l;
             hi[i] = h;
-            magnitude[i] = s.to_f64();
+            magnitude[i] = s;
         }
         Expected::Faces { lo, hi, magnitude }
+    }
+}
+
+impl<const N: usize> Exactly<N> for Problem<N> {
+    fn lo(&self) -> [f32; N] {
+        self.lo
+    }
+    fn hi(&self) -> [f32; N] {
+        self.hi
+    }
+    fn t(&self) -> [f32; N] {
+        self.t
+    }
+    fn map_values(&self) -> Vec<f32> {
+        self.cols.iter().flatten().chain(&self.t).copied().collect()
+    }
+    fn exact_cols(&self) -> [[Exact; N]; N] {
+        self.cols.map(|c| c.map(Exact::of))
+    }
+    fn approx_cols(&self) -> ([[f64; N]; N], [f64; N]) {
+        (self.cols.map(|c| c.map(f64::from)), [0.0; N])
+    }
+    fn weights(&self) -> [[f64; N]; N] {
+        core::array::from_fn(|i| core::array::from_fn(|j| f64::from(self.cols[j][i]).abs()))
+    }
+    fn tau(&self) -> f64 {
+        1.0
+    }
+    fn with_box(&self, lo: [f32; N], hi: [f32; N]) -> Self {
+        Problem { lo, hi, ..*self }
+    }
+}
+
+impl QuatProblem {
+    /// `ρ = 1 + 2‖q‖²` in `f64`.
+    pub fn rho(&self) -> f64 {
+        1.0 + 2.0
+            * self
+                .q
+                .iter()
+                .map(|&c| f64::from(c) * f64::from(c))
+                .sum::<f64>()
+    }
+
+    /// The exact `R(q)`, rows then columns: `r[i][j] = R_ij`.
+    fn exact_rotation(&self) -> [[Exact; 3]; 3] {
+        let [x, y, z, w] = self.q;
+        let p = Exact::product;
+        let one = Exact::of(1.0);
+        let diag = |a: f32, b: f32| one.add(&p(a, a).add(&p(b, b)).double().neg());
+        let off = |a: Exact, b: Exact| a.add(&b).double();
+        [
+            [
+                diag(y, z),
+                off(p(x, y), p(w, z).neg()),
+                off(p(x, z), p(w, y)),
+            ],
+            [
+                off(p(x, y), p(w, z)),
+                diag(x, z),
+                off(p(y, z), p(w, x).neg()),
+            ],
+            [
+                off(p(x, z), p(w, y).neg()),
+                off(p(y, z), p(w, x)),
+                diag(x, y),
+            ],
+        ]
+    }
+}
+
+impl Exactly<3> for QuatProblem {
+    fn lo(&self) -> [f32; 3] {
+        self.lo
+    }
+    fn hi(&self) -> [f32; 3] {
+        self.hi
+    }
+    fn t(&self) -> [f32; 3] {
+        self.t
+    }
+    fn map_values(&self) -> Vec<f32> {
+        self.q
+            .iter()
+            .chain(&self.s)
+            .chain(&self.t)
+            .copied()
+            .collect()
+    }
+    fn exact_cols(&self) -> [[Exact; 3]; 3] {
+        let r = self.exact_rotation();
+        core::array::from_fn(|j| core::array::from_fn(|i| r[i][j].mul_f32(self.s[j])))
+    }
+    fn approx_cols(&self) -> ([[f64; 3]; 3], [f64; 3]) {
+        // Each entry of R is a sum of at most three exact f64 terms (2 roundings), times
+        // s_j (one more): within 4·2^-53·ρ·|s_j|; twice that is kept.
+        let r = self.exact_rotation();
+        let rho = self.rho();
+        (
+            core::array::from_fn(|j| {
+                core::array::from_fn(|i| r[i][j].to_f64() * f64::from(self.s[j]))
+            }),
+            core::array::from_fn(|j| 8.0 * f64::EPSILON / 2.0 * rho * f64::from(self.s[j]).abs()),
+        )
+    }
+    fn weights(&self) -> [[f64; 3]; 3] {
+        let rho = self.rho();
+        [core::array::from_fn(|j| rho * f64::from(self.s[j]).abs()); 3]
+    }
+    fn tau(&self) -> f64 {
+        2.0 * self.rho()
+    }
+    fn with_box(&self, lo: [f32; 3], hi: [f32; 3]) -> Self {
+        QuatProblem { lo, hi, ..*self }
     }
 }
 
@@ -238,10 +423,24 @@ impl Bound {
         }
     }
 
-    fn allowance(&self, magnitude: f64) -> f64 {
+    /// The bound of order `gamma_n` (Nearest) or pad `gamma_n + 2` (Outward).
+    pub fn of_order(gamma_n: u32, rounding: Rounding) -> Bound {
+        match rounding {
+            Rounding::Nearest => Bound::Nearest {
+                gamma_n,
+                tiny: f64::from(TINY_ERROR),
+            },
+            Rounding::Outward => Bound::Outward {
+                k: gamma_n + 2,
+                tiny: f64::from(TINY_PAD),
+            },
+        }
+    }
+
+    fn allowance(&self, magnitude: f64, tau: f64) -> f64 {
         match *self {
-            Bound::Nearest { gamma_n, tiny } => gamma(gamma_n) * magnitude + tiny,
-            Bound::Outward { k, tiny } => 2.0 * (f64::from(k) * U * magnitude + tiny),
+            Bound::Nearest { gamma_n, tiny } => gamma(gamma_n) * magnitude + tau * tiny,
+            Bound::Outward { k, tiny } => 2.0 * (f64::from(k) * U * magnitude + tau * tiny),
         }
     }
 }
@@ -262,6 +461,7 @@ fn check_face(
     face: f32,
     exact: &Exact,
     magnitude: f64,
+    tau: f64,
     bound: Bound,
     lower: bool,
 ) -> Result<(f64, bool), String> {
@@ -280,7 +480,7 @@ fn check_face(
             exact.to_f64()
         ));
     }
-    let allowance = bound.allowance(magnitude);
+    let allowance = bound.allowance(magnitude, tau);
     match exact {
         Exact::Finite(_) => {}
         inf => {
@@ -320,7 +520,7 @@ fn check_face(
 
 /// Checks a result against the contract and measures it.
 pub fn check<const N: usize>(
-    p: &Problem<N>,
+    p: &impl Exactly<N>,
     min: [f32; N],
     max: [f32; N],
     bound: Bound,
@@ -334,48 +534,53 @@ pub fn check<const N: usize>(
 /// The same verdict as [`check_exact`] when `f64` arithmetic with a rigorous error bound
 /// decides every comparison; `None` (undecided, or a failure to report exactly) otherwise.
 ///
-/// For finite inputs each product of two `f32` is exact in `f64` and the sum of `N + 1`
-/// terms errs by at most `N·2^-53` times the sum of their magnitudes; the bound used here
-/// is twice that plus the smallest normal `f64`, which also covers the rounding of the
-/// comparisons themselves. Only verdicts that hold for every value within the bound are
-/// returned, so the oracle stays exact; it is only faster where nothing is close.
+/// For finite inputs each matrix entry is known in `f64` within its column's error bound
+/// (exactly for an affine map), each product with a coordinate rounds at most once, and
+/// the sum of `N + 1` terms errs by at most `N·2^-53` times the sum of their magnitudes;
+/// the bound used here is `(N + 3)·2^-52` of that, plus the entries' errors, plus the
+/// smallest normal `f64`, which also covers the rounding of the comparisons themselves.
+/// Only verdicts that hold for every value within the bound are returned, so the oracle
+/// stays exact; it is only faster where nothing is close.
 fn check_certified_f64<const N: usize>(
-    p: &Problem<N>,
+    p: &impl Exactly<N>,
     min: [f32; N],
     max: [f32; N],
     bound: Bound,
 ) -> Option<Measured> {
-    let all = p
-        .cols
-        .iter()
-        .flatten()
-        .chain(&p.t)
-        .chain(&p.lo)
-        .chain(&p.hi);
-    if !all.clone().all(|x| x.is_finite()) || p.is_empty() {
+    if !p.all_finite() || p.is_empty() {
         return None;
     }
     if !min.iter().chain(&max).all(|x| x.is_finite()) {
         return None;
     }
+    let (lo_in, hi_in, t_in) = (p.lo(), p.hi(), p.t());
+    let (cols, col_error) = p.approx_cols();
+    let weights = p.weights();
+    let tau = p.tau();
     let mut measured = Measured {
         contains: true,
         ..Measured::default()
     };
     let (mut exact_volume, mut volume) = (1.0f64, 1.0f64);
     for i in 0..N {
-        let t = f64::from(p.t[i]);
-        let (mut lo, mut hi, mut magnitude) = (t, t, t.abs());
+        let t = f64::from(t_in[i]);
+        let (mut lo, mut hi, mut terms, mut magnitude) = (t, t, t.abs(), t.abs());
+        let mut entry_error = 0.0;
         for j in 0..N {
-            let m = f64::from(p.cols[j][i]);
-            let (a, b) = (m * f64::from(p.lo[j]), m * f64::from(p.hi[j]));
+            let m = cols[j][i];
+            let (x_lo, x_hi) = (f64::from(lo_in[j]), f64::from(hi_in[j]));
+            let (a, b) = (m * x_lo, m * x_hi);
             lo += a.min(b);
             hi += a.max(b);
-            magnitude += a.abs().max(b.abs());
+            let reach = x_lo.abs().max(x_hi.abs());
+            terms += a.abs().max(b.abs());
+            magnitude += weights[i][j] * reach;
+            entry_error += col_error[j] * reach;
         }
-        let error =
-            2.0 * (N as f64 + 1.0) * f64::EPSILON / 2.0 * magnitude * 1.001 + f64::MIN_POSITIVE;
-        let allowance = bound.allowance(magnitude * (1.0 - 1e-9));
+        let error = (N as f64 + 3.0) * f64::EPSILON * terms * 1.001
+            + entry_error * 1.001
+            + f64::MIN_POSITIVE;
+        let allowance = bound.allowance(magnitude * (1.0 - 1e-9), tau);
         for (face, exact, lower) in [(min[i], lo, true), (max[i], hi, false)] {
             let face = f64::from(face);
             let gap = face - exact; // exact − face is within ±error of the true difference
@@ -409,11 +614,12 @@ fn check_certified_f64<const N: usize>(
 
 /// Checks a result against the contract in exact arithmetic and measures it.
 pub fn check_exact<const N: usize>(
-    p: &Problem<N>,
+    p: &impl Exactly<N>,
     min: [f32; N],
     max: [f32; N],
     bound: Bound,
 ) -> Result<Measured, String> {
+    let tau = p.tau();
     match p.expected() {
         Expected::Invalid => {
             if min.iter().chain(&max).any(|x| x.is_nan()) {
@@ -442,8 +648,8 @@ pub fn check_exact<const N: usize>(
             let (mut exact_volume, mut volume) = (1.0f64, 1.0f64);
             for i in 0..N {
                 for (face, exact, lower) in [(min[i], &lo[i], true), (max[i], &hi[i], false)] {
-                    let (error, contains) = check_face(face, exact, magnitude[i], bound, lower)
-                        .map_err(|e| {
+                    let (error, contains) =
+                        check_face(face, exact, magnitude[i], tau, bound, lower).map_err(|e| {
                             format!("axis {i} {}: {e}", if lower { "min" } else { "max" })
                         })?;
                     measured.worst_error_us = measured.worst_error_us.max(error);
@@ -512,6 +718,39 @@ pub fn affine2(p: &Problem<2>) -> (Aabb2, Affine2) {
         Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi)),
         xf,
     )
+}
+
+impl QuatProblem {
+    /// The box.
+    pub fn aabb(&self) -> Aabb3 {
+        Aabb3::new(Vec3A::from_array(self.lo), Vec3A::from_array(self.hi))
+    }
+    fn quat(&self) -> Quat {
+        Quat::from_array(self.q)
+    }
+    /// As a rigid pose (the scale must be 1).
+    pub fn rigid3(&self) -> Rigid3 {
+        assert_eq!(self.s, [1.0; 3], "a rigid problem has unit scale");
+        Rigid3::new(self.quat(), Vec3A::from_array(self.t))
+    }
+    /// As a similarity (the scale must be uniform).
+    pub fn similarity3(&self) -> Similarity3 {
+        assert!(
+            self.s[0].to_bits() == self.s[1].to_bits()
+                && self.s[1].to_bits() == self.s[2].to_bits()
+                || self.s.iter().all(|x| x.is_nan()),
+            "a similarity problem has a uniform scale"
+        );
+        Similarity3::new(self.s[0], self.quat(), Vec3A::from_array(self.t))
+    }
+    /// As a scale-rotation-translation.
+    pub fn trs3(&self) -> Trs3 {
+        Trs3::new(
+            Vec3A::from_array(self.s),
+            self.quat(),
+            Vec3A::from_array(self.t),
+        )
+    }
 }
 
 /// A 2D problem as a rigid transform `(cos, sin)` taken from its first column; the

@@ -1,0 +1,525 @@
+//! Every transform class × method × rounding × path × layout × supported backend, against
+//! the exact oracle and the scalar reference, at awkward lengths and over every extreme
+//! class; and the batch entry point's length checks.
+
+mod cases;
+mod oracle;
+
+use bvkit::transform::{Transform2, Transform3};
+use bvkit::{
+    Aabb2, Aabb3, Aabb3x8, Backend, Batch, BatchError, Block8, Method, Rigid2, Rigid3, Rounding,
+    Similarity3, Soa, Translation2, Translation3, Trs3,
+};
+use glam::{Affine2, Affine3A, Vec2, Vec3A};
+use proptest::prelude::*;
+use rand::RngExt;
+use rand::rngs::StdRng;
+
+use cases::{Class, Scale, problem, quat_problem, rigid_problem, rng, translation_problem};
+use oracle::{Bound, Exactly, Problem, QuatProblem, affine2, affine3, check, rigid2};
+
+/// A transform class under test: its problems, as bvkit's inputs, and its paths.
+trait Case<const N: usize> {
+    type P: Exactly<N> + Copy;
+    type B: Copy + core::fmt::Debug + PartialEq;
+    type T: Copy + core::fmt::Debug;
+    const NAME: &'static str;
+    fn make(class: Class, r: &mut StdRng) -> Self::P;
+    fn inputs(p: &Self::P) -> (Self::B, Self::T);
+    fn faces(b: &Self::B) -> ([f32; N], [f32; N]);
+    fn order(method: Method) -> u32;
+    /// The single-box paths: (name, result).
+    fn single(b: &Self::B, xf: &Self::T, m: Method, r: Rounding) -> Vec<(&'static str, Self::B)>;
+    /// The scalar reference.
+    fn scalar(b: &Self::B, xf: &Self::T, m: Method, r: Rounding) -> Self::B;
+    /// Every batch layout, as (name, result); names with "shared" ran every box through
+    /// the first transform.
+    fn batches(
+        batch: Batch,
+        local: &[Self::B],
+        xfs: &[Self::T],
+    ) -> Vec<(&'static str, Vec<Self::B>)>;
+}
+
+/// The batch layouts of one box type and transform class, through the one entry point:
+/// AoS, AoSoA, SoA, and one shared transform. (Every call site compiles the kernels for
+/// every backend, so the other forms, which only delegate, are tested once, on `Rigid3`.)
+macro_rules! batches {
+    ($batch:expr, $local:expr, $xfs:expr, $B:ty, $empty:expr) => {{
+        let (batch, local, xfs): (Batch, &[$B], &[_]) = ($batch, $local, $xfs);
+        let n = local.len();
+        let mut results = Vec::new();
+        let mut out = vec![$empty; n];
+        batch.transform(local, xfs, &mut out[..]).unwrap();
+        results.push(("aos", out));
+        let (lb, xb) = (Block8::pack(local), Block8::pack(xfs));
+        let mut ob = vec![Block8::default(); lb.len()];
+        batch.transform(&lb[..], &xb[..], &mut ob[..]).unwrap();
+        results.push(("aosoa", Block8::unpack(&ob, n)));
+        let (ls, xs) = (Soa::from_slice(local), Soa::from_slice(xfs));
+        let mut os = Soa::filled(n, $empty);
+        batch
+            .transform(ls.view(), xs.view(), os.view_mut())
+            .unwrap();
+        results.push(("soa", (0..n).map(|k| os.get(k)).collect()));
+        if let Some(first) = xfs.first() {
+            let mut out = vec![$empty; n];
+            batch.transform(local, first, &mut out[..]).unwrap();
+            results.push(("shared", out));
+        }
+        results
+    }};
+}
+
+macro_rules! case3 {
+    ($case:ident, $T:ty, $P:ty, $make:expr, $inputs:expr) => {
+        struct $case;
+        impl Case<3> for $case {
+            type P = $P;
+            type B = Aabb3;
+            type T = $T;
+            const NAME: &'static str = stringify!($T);
+            fn make(class: Class, r: &mut StdRng) -> $P {
+                $make(class, r)
+            }
+            fn inputs(p: &$P) -> (Aabb3, $T) {
+                $inputs(p)
+            }
+            fn faces(b: &Aabb3) -> ([f32; 3], [f32; 3]) {
+                (b.min.to_array(), b.max.to_array())
+            }
+            fn order(method: Method) -> u32 {
+                <$T as Transform3>::nearest_gamma(method)
+            }
+            fn single(b: &Aabb3, xf: &$T, m: Method, r: Rounding) -> Vec<(&'static str, Aabb3)> {
+                vec![
+                    ("single simd", b.transformed(xf, m, r)),
+                    ("single scalar", b.transformed_scalar(xf, m, r)),
+                ]
+            }
+            fn scalar(b: &Aabb3, xf: &$T, m: Method, r: Rounding) -> Aabb3 {
+                b.transformed_scalar(xf, m, r)
+            }
+            fn batches(
+                batch: Batch,
+                local: &[Aabb3],
+                xfs: &[$T],
+            ) -> Vec<(&'static str, Vec<Aabb3>)> {
+                batches!(batch, local, xfs, Aabb3, Aabb3::NAN)
+            }
+        }
+    };
+}
+
+macro_rules! case2 {
+    ($case:ident, $T:ty, $make:expr, $inputs:expr) => {
+        struct $case;
+        impl Case<2> for $case {
+            type P = Problem<2>;
+            type B = Aabb2;
+            type T = $T;
+            const NAME: &'static str = stringify!($T);
+            fn make(class: Class, r: &mut StdRng) -> Problem<2> {
+                $make(class, r)
+            }
+            fn inputs(p: &Problem<2>) -> (Aabb2, $T) {
+                $inputs(p)
+            }
+            fn faces(b: &Aabb2) -> ([f32; 2], [f32; 2]) {
+                (b.min.to_array(), b.max.to_array())
+            }
+            fn order(method: Method) -> u32 {
+                <$T as Transform2>::nearest_gamma(method)
+            }
+            fn single(b: &Aabb2, xf: &$T, m: Method, r: Rounding) -> Vec<(&'static str, Aabb2)> {
+                vec![("single", b.transformed(xf, m, r))]
+            }
+            fn scalar(b: &Aabb2, xf: &$T, m: Method, r: Rounding) -> Aabb2 {
+                b.transformed(xf, m, r)
+            }
+            fn batches(
+                batch: Batch,
+                local: &[Aabb2],
+                xfs: &[$T],
+            ) -> Vec<(&'static str, Vec<Aabb2>)> {
+                batches!(batch, local, xfs, Aabb2, Aabb2::NAN)
+            }
+        }
+    };
+}
+
+fn box3(p: &Problem<3>) -> Aabb3 {
+    Aabb3::new(Vec3A::from_array(p.lo), Vec3A::from_array(p.hi))
+}
+
+fn box2(p: &Problem<2>) -> Aabb2 {
+    Aabb2::new(Vec2::from_array(p.lo), Vec2::from_array(p.hi))
+}
+
+case3!(CaseAffine3, Affine3A, Problem<3>, problem::<3>, affine3);
+case3!(
+    CaseTranslation3,
+    Translation3,
+    Problem<3>,
+    translation_problem::<3>,
+    |p: &Problem<3>| (box3(p), Translation3(Vec3A::from_array(p.t)))
+);
+case3!(
+    CaseRigid3,
+    Rigid3,
+    QuatProblem,
+    |c, r| quat_problem(c, Scale::Unit, r),
+    |p: &QuatProblem| (p.aabb(), p.rigid3())
+);
+case3!(
+    CaseSimilarity3,
+    Similarity3,
+    QuatProblem,
+    |c, r| quat_problem(c, Scale::Uniform, r),
+    |p: &QuatProblem| (p.aabb(), p.similarity3())
+);
+case3!(
+    CaseTrs3,
+    Trs3,
+    QuatProblem,
+    |c, r| quat_problem(c, Scale::PerAxis, r),
+    |p: &QuatProblem| (p.aabb(), p.trs3())
+);
+case2!(CaseAffine2, Affine2, problem::<2>, affine2);
+case2!(CaseRigid2, Rigid2, rigid_problem, rigid2);
+case2!(
+    CaseTranslation2,
+    Translation2,
+    translation_problem::<2>,
+    |p: &Problem<2>| (box2(p), Translation2(Vec2::from_array(p.t)))
+);
+
+/// Same faces: equal values (min/max may pick either zero of `max(+0, -0)`), NaN as NaN.
+fn same(a: &[f32], b: &[f32]) -> bool {
+    a.iter()
+        .zip(b)
+        .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
+}
+
+/// Backends whose arithmetic is the scalar reference's, rounding for rounding (no FMA).
+fn bitwise_like_scalar(b: Backend) -> bool {
+    matches!(b, Backend::Scalar | Backend::Baseline)
+        || (b == Backend::Wide && !cfg!(target_feature = "fma"))
+}
+
+/// Every single-box path of one problem against the oracle.
+fn check_single<const N: usize, C: Case<N>>(p: &C::P) -> Result<(), String> {
+    let (b, xf) = C::inputs(p);
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let bound = Bound::of_order(C::order(method), rounding);
+            for (path, out) in C::single(&b, &xf, method, rounding) {
+                let (min, max) = C::faces(&out);
+                check(p, min, max, bound).map_err(|e| {
+                    format!("{} {method:?} {rounding:?} {path}: {e}\n{p:?}", C::NAME)
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Problems of mixed classes, so that lanes of one block take different paths.
+fn mixed<const N: usize, C: Case<N>>(len: usize, seed: u64) -> Vec<C::P> {
+    let r = &mut rng(seed);
+    (0..len)
+        .map(|_| {
+            let class = if r.random_bool(0.7) {
+                Class::Typical
+            } else {
+                Class::ALL[r.random_range(0..Class::ALL.len())]
+            };
+            C::make(class, r)
+        })
+        .collect()
+}
+
+/// Every layout on every backend, every method and rounding, at awkward lengths.
+fn every_layout<const N: usize, C: Case<N>>() {
+    let random_len = rng(7).random_range(100..1500);
+    for (n, len) in [0, 1, 7, 8, 9, 16, 63, 300, random_len]
+        .into_iter()
+        .enumerate()
+    {
+        let ps = mixed::<N, C>(len, 100 + n as u64);
+        let (local, xfs): (Vec<C::B>, Vec<C::T>) = ps.iter().map(C::inputs).unzip();
+        for method in Method::ALL {
+            for rounding in Rounding::ALL {
+                let bound = Bound::of_order(C::order(method), rounding);
+                let reference: Vec<C::B> = local
+                    .iter()
+                    .zip(&xfs)
+                    .map(|(b, x)| C::scalar(b, x, method, rounding))
+                    .collect();
+                for backend in Backend::supported() {
+                    let batch = Batch::new(method, rounding).on(backend).unwrap();
+                    let bitwise = bitwise_like_scalar(backend);
+                    for (layout, out) in C::batches(batch, &local, &xfs) {
+                        let name = format!(
+                            "{} {layout} {backend:?} {method:?} {rounding:?} len {len}",
+                            C::NAME
+                        );
+                        let shared = layout.contains("shared");
+                        assert_eq!(out.len(), len, "{name}");
+                        for (k, (p, o)) in ps.iter().zip(&out).enumerate() {
+                            let p = if shared {
+                                ps[0].with_box(p.lo(), p.hi())
+                            } else {
+                                *p
+                            };
+                            let (min, max) = C::faces(o);
+                            if let Err(e) = check(&p, min, max, bound) {
+                                panic!("{name} box {k}: {e}\n{p:?}");
+                            }
+                            let (rmin, rmax) = C::faces(&reference[k]);
+                            assert!(
+                                shared || !bitwise || (same(&min, &rmin) && same(&max, &rmax)),
+                                "{name} box {k}: {o:?} != scalar {:?}",
+                                reference[k]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn affine3_every_layout_on_every_backend() {
+    every_layout::<3, CaseAffine3>();
+}
+
+#[test]
+fn translation3_every_layout_on_every_backend() {
+    every_layout::<3, CaseTranslation3>();
+}
+
+#[test]
+fn rigid3_every_layout_on_every_backend() {
+    every_layout::<3, CaseRigid3>();
+}
+
+#[test]
+fn similarity3_every_layout_on_every_backend() {
+    every_layout::<3, CaseSimilarity3>();
+}
+
+#[test]
+fn trs3_every_layout_on_every_backend() {
+    every_layout::<3, CaseTrs3>();
+}
+
+#[test]
+fn affine2_every_layout_on_every_backend() {
+    every_layout::<2, CaseAffine2>();
+}
+
+#[test]
+fn rigid2_every_layout_on_every_backend() {
+    every_layout::<2, CaseRigid2>();
+}
+
+#[test]
+fn translation2_every_layout_on_every_backend() {
+    every_layout::<2, CaseTranslation2>();
+}
+
+fn class() -> impl Strategy<Value = Class> {
+    proptest::sample::select(Class::ALL.to_vec())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn translation3_single_box(class in class(), seed in any::<u64>()) {
+        let p = CaseTranslation3::make(class, &mut rng(seed));
+        let r = check_single::<3, CaseTranslation3>(&p);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+
+    #[test]
+    fn rigid3_single_box(class in class(), seed in any::<u64>()) {
+        let p = CaseRigid3::make(class, &mut rng(seed));
+        let r = check_single::<3, CaseRigid3>(&p);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+
+    #[test]
+    fn similarity3_single_box(class in class(), seed in any::<u64>()) {
+        let p = CaseSimilarity3::make(class, &mut rng(seed));
+        let r = check_single::<3, CaseSimilarity3>(&p);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+
+    #[test]
+    fn trs3_single_box(class in class(), seed in any::<u64>()) {
+        let p = CaseTrs3::make(class, &mut rng(seed));
+        let r = check_single::<3, CaseTrs3>(&p);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+
+    #[test]
+    fn translation2_single_box(class in class(), seed in any::<u64>()) {
+        let p = CaseTranslation2::make(class, &mut rng(seed));
+        let r = check_single::<2, CaseTranslation2>(&p);
+        prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+}
+
+/// The forms that delegate to the layouts above: `Vec`s by reference, owned SoA by
+/// reference, mixed layouts, a shared transform over AoSoA boxes.
+#[test]
+fn every_form_of_the_entry_point() {
+    let ps = mixed::<3, CaseRigid3>(203, 9);
+    let (local, xfs): (Vec<Aabb3>, Vec<Rigid3>) = ps.iter().map(CaseRigid3::inputs).unzip();
+    let n = local.len();
+    for method in Method::ALL {
+        for rounding in Rounding::ALL {
+            let batch = Batch::new(method, rounding);
+            let bound = Bound::of_order(CaseRigid3::order(method), rounding);
+            let mut expect = vec![Aabb3::NAN; n];
+            batch
+                .transform(&local[..], &xfs[..], &mut expect[..])
+                .unwrap();
+            let mut shared = vec![Aabb3::NAN; n];
+            batch
+                .transform(&local[..], &xfs[0], &mut shared[..])
+                .unwrap();
+
+            let same_box = |a: &Aabb3, b: &Aabb3| {
+                let (a, b) = (CaseRigid3::faces(a), CaseRigid3::faces(b));
+                same(&a.0, &b.0) && same(&a.1, &b.1)
+            };
+            let mut out = vec![Aabb3::NAN; n];
+            batch.transform(&local, &xfs, &mut out).unwrap();
+            assert!(
+                out.iter().zip(&expect).all(|(a, b)| same_box(a, b)),
+                "Vec by reference"
+            );
+
+            let (ls, xs) = (Soa::from_slice(&local), Soa::from_slice(&xfs));
+            let mut os = Soa::filled(n, Aabb3::NAN);
+            batch.transform(&ls, &xs, &mut os).unwrap();
+            assert!(
+                (0..n).all(|k| same_box(&os.get(k), &expect[k])),
+                "owned SoA"
+            );
+
+            // AoSoA boxes, AoS transforms (the length must be a multiple of 8).
+            let m = n / 8 * 8;
+            let lb = Block8::pack(&local[..m]);
+            let mut ob = vec![Aabb3x8::default(); lb.len()];
+            batch.transform(&lb, &xfs[..m], &mut ob).unwrap();
+            let got: Vec<Aabb3> = Block8::unpack(&ob, m);
+            assert!(
+                got.iter().zip(&expect).all(|(a, b)| same_box(a, b)),
+                "AoSoA boxes, AoS transforms"
+            );
+
+            let lb = Block8::pack(&local);
+            let mut ob = vec![Aabb3x8::default(); lb.len()];
+            batch.transform(&lb, &xfs[0], &mut ob).unwrap();
+            let got: Vec<Aabb3> = Block8::unpack(&ob, n);
+            for (k, (p, o)) in ps.iter().zip(&got).enumerate() {
+                let p = ps[0].with_box(p.lo, p.hi);
+                let r = check(&p, o.min.to_array(), o.max.to_array(), bound);
+                assert!(r.is_ok(), "AoSoA shared box {k}: {}", r.unwrap_err());
+                assert!(same_box(o, &shared[k]), "AoSoA shared box {k}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_lengths_are_refused_and_leave_the_output_untouched() {
+    let local = vec![Aabb3::new(Vec3A::ZERO, Vec3A::ONE); 10];
+    let xfs = vec![Rigid3::IDENTITY; 9];
+    let sentinel = Aabb3::new(Vec3A::splat(7.0), Vec3A::splat(8.0));
+    for backend in Backend::supported() {
+        let batch = Batch::new(Method::SignSelect, Rounding::Outward)
+            .on(backend)
+            .unwrap();
+        let mut out = vec![sentinel; 10];
+        assert_eq!(
+            batch.transform(&local, &xfs, &mut out),
+            Err(BatchError::LengthMismatch {
+                what: "transforms",
+                expected: 10,
+                found: 9
+            })
+        );
+        assert!(out.iter().all(|b| *b == sentinel));
+        let mut short = vec![sentinel; 11];
+        let err = batch
+            .transform(&local, &Trs3::IDENTITY, &mut short)
+            .unwrap_err();
+        assert_eq!(
+            err,
+            BatchError::LengthMismatch {
+                what: "output",
+                expected: 10,
+                found: 11
+            }
+        );
+        assert!(short.iter().all(|b| *b == sentinel));
+        assert!(!err.to_string().is_empty());
+
+        let (l8, x8) = (Block8::pack(&local), Block8::pack(&xfs[..8]));
+        let mut o8 = vec![Block8::from([sentinel; 8]); 2];
+        assert!(batch.transform(&l8, &x8, &mut o8).is_err());
+        assert!(o8.iter().all(|b| *b == Block8::from([sentinel; 8])));
+
+        let soa = Soa::from_slice(&local);
+        let mut ragged = soa.clone();
+        ragged.columns[5].pop();
+        let mut out_soa = Soa::filled(10, sentinel);
+        let before = out_soa.clone();
+        let xsoa = Soa::from_slice(&[Similarity3::IDENTITY; 10]);
+        assert!(matches!(
+            batch.transform(ragged.view(), xsoa.view(), out_soa.view_mut()),
+            Err(BatchError::LengthMismatch { .. })
+        ));
+        let mut xragged = xsoa.clone();
+        xragged.columns[7].push(0.0);
+        assert!(matches!(
+            batch.transform(&soa, &xragged, &mut out_soa),
+            Err(BatchError::LengthMismatch { .. })
+        ));
+        assert_eq!(out_soa, before);
+
+        let l2 = vec![Aabb2::new(Vec2::ZERO, Vec2::ONE); 3];
+        let mut o2 = vec![Aabb2::EMPTY; 2];
+        assert!(
+            batch
+                .transform(&l2, &[Rigid2::IDENTITY; 3][..], &mut o2)
+                .is_err()
+        );
+        assert!(o2.iter().all(|b| *b == Aabb2::EMPTY));
+    }
+}
+
+#[test]
+fn backends_are_detected_and_forced() {
+    let supported = Backend::supported();
+    assert!(supported.contains(&Backend::Scalar) && supported.contains(&Backend::Baseline));
+    assert!(supported.contains(&Backend::detect()));
+    for b in Backend::ALL {
+        let forced = Batch::new(Method::Naive, Rounding::Nearest).on(b);
+        assert_eq!(forced.is_ok(), b.is_supported());
+        if let Ok(batch) = forced {
+            assert_eq!(batch.backend(), b);
+        }
+    }
+    // On x86-64 with AVX2 the detected backend must be a runtime-dispatched one.
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        assert!(matches!(Backend::detect(), Backend::Avx2 | Backend::Avx512));
+    }
+}
