@@ -39,6 +39,7 @@ mod aabb;
 mod batch;
 mod block;
 mod error;
+mod fit;
 mod extended;
 mod kernel;
 mod lane;
@@ -54,6 +55,7 @@ pub use batch::{
     BatchError, transform_slice,
 };
 pub use error::TransformError;
+pub use fit::{Capsule, Fit, FitError, Obb3, Sphere};
 pub use method::{Method, Rounding};
 pub use rigid2::Rigid2;
 pub use simd::Backend;
