@@ -100,7 +100,8 @@ impl Volume for Obb3 {
         let c = fixed3(self.center);
         let (min, max) = (fixed3(self.aabb().min), fixed3(self.aabb().max));
         (0..3).all(|i| {
-            let reach: BigInt = (0..3).map(|k| dual[k][i].abs() * &h[k]).sum::<BigInt>() << 149usize;
+            let reach: BigInt =
+                (0..3).map(|k| dual[k][i].abs() * &h[k]).sum::<BigInt>() << 149usize;
             (&max[i] - &c[i]) * &det >= reach && (&c[i] - &min[i]) * &det >= reach
         })
     }
@@ -194,12 +195,24 @@ fn all_meshes() -> Vec<(&'static str, Vec<Vec3>)> {
     meshes.extend(meshes::procedural());
     meshes.extend([
         ("planar", meshes::planar(12)),
-        ("planar tilted", meshes::rotated(&meshes::planar(12), meshes::tilt())),
+        (
+            "planar tilted",
+            meshes::rotated(&meshes::planar(12), meshes::tilt()),
+        ),
         ("collinear", meshes::collinear(15)),
-        ("collinear tilted", meshes::rotated(&meshes::collinear(15), meshes::tilt())),
+        (
+            "collinear tilted",
+            meshes::rotated(&meshes::collinear(15), meshes::tilt()),
+        ),
         ("one point", vec![Vec3::new(1.5, -2.25, 1e-3)]),
         ("two points", vec![Vec3::ZERO, Vec3::new(1e-30, 3.0, -7.0)]),
-        ("far away", meshes::rotated(&meshes::uv_sphere(1e-3, 5, 7), meshes::tilt()).iter().map(|&p| p + Vec3::splat(1e4)).collect()),
+        (
+            "far away",
+            meshes::rotated(&meshes::uv_sphere(1e-3, 5, 7), meshes::tilt())
+                .iter()
+                .map(|&p| p + Vec3::splat(1e4))
+                .collect(),
+        ),
         ("spot twice", twice),
     ]);
     meshes
@@ -213,10 +226,23 @@ fn check_containment<V: Volume>() {
             let fitted = V::fit(&points, mode).unwrap();
             for &p in &points {
                 let p = Vec3A::from(p);
-                assert!(fitted.holds_exactly(p), "{} {mode:?} {name}: {p} outside {fitted:?}", V::NAME);
-                assert!(fitted.contains_point(p), "{} {mode:?} {name}: contains_point({p})", V::NAME);
+                assert!(
+                    fitted.holds_exactly(p),
+                    "{} {mode:?} {name}: {p} outside {fitted:?}",
+                    V::NAME
+                );
+                assert!(
+                    fitted.contains_point(p),
+                    "{} {mode:?} {name}: contains_point({p})",
+                    V::NAME
+                );
             }
-            assert!(fitted.aabb_holds_exactly(), "{} {mode:?} {name}: {:?}", V::NAME, fitted.aabb());
+            assert!(
+                fitted.aabb_holds_exactly(),
+                "{} {mode:?} {name}: {:?}",
+                V::NAME,
+                fitted.aabb()
+            );
             assert!(fitted.volume().is_finite());
         }
     }

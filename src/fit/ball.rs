@@ -69,7 +69,12 @@ impl<const D: usize> Ball<D> {
             .collect();
         let lambda = solve(&mut g);
         let center = core::array::from_fn(|d| {
-            s0[d] + edges.iter().zip(&lambda).map(|(e, l)| l * e[d]).sum::<f64>()
+            s0[d]
+                + edges
+                    .iter()
+                    .zip(&lambda)
+                    .map(|(e, l)| l * e[d])
+                    .sum::<f64>()
         });
         let radius2 = support
             .iter()
@@ -144,7 +149,12 @@ mod tests {
         let square = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0], [1.0, 1.0]];
         let b = smallest_ball(&square);
         assert!((b.center[0] - 1.0).abs() < 1e-12 && (b.radius2 - 2.0).abs() < 1e-12);
-        let line = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [3.0, 3.0, 3.0], [2.0, 2.0, 2.0]];
+        let line = [
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [3.0, 3.0, 3.0],
+            [2.0, 2.0, 2.0],
+        ];
         let b = smallest_ball(&line);
         assert!((b.radius2 - 6.75).abs() < 1e-12, "{b:?}");
         let one = [[5.0, -1.0, 2.0]];

@@ -121,7 +121,9 @@ fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Shape {
     for &p in points {
         let v = p - origin;
         let s = v.dot(dir);
-        let w = (radius * radius - (v - dir * s).length_squared()).max(0.0).sqrt();
+        let w = (radius * radius - (v - dir * s).length_squared())
+            .max(0.0)
+            .sqrt();
         top = top.max(s - w);
         bottom = bottom.min(s + w);
     }
@@ -145,7 +147,10 @@ fn circle_axis(points: &[DVec3], dir: DVec3) -> (DVec3, f64) {
     let mut flat: Vec<[f64; 2]> = points.iter().map(|p| [p.dot(e1), p.dot(e2)]).collect();
     cloud::shuffle(&mut flat);
     let circle = smallest_ball(&flat);
-    (e1 * circle.center[0] + e2 * circle.center[1], circle.radius())
+    (
+        e1 * circle.center[0] + e2 * circle.center[1],
+        circle.radius(),
+    )
 }
 
 /// The capsule along `dir` centered by the minimum enclosing circle, with minimal caps.
@@ -184,7 +189,8 @@ fn pca_shape(points: &[Vec3]) -> Shape {
 /// enclosing circle.
 fn fast_shape(points: &[Vec3]) -> Shape {
     let exact_points: Vec<DVec3> = points.iter().map(|&p| exact(p)).collect();
-    let frame = Obb3::fit(points, Fit::Fast).map_or(glam::DMat3::IDENTITY, |b| b.rotation.as_dmat3());
+    let frame =
+        Obb3::fit(points, Fit::Fast).map_or(glam::DMat3::IDENTITY, |b| b.rotation.as_dmat3());
     smallest((0..3).filter_map(|k| {
         let dir = frame.col(k).try_normalize()?;
         Some(circle_shape(&exact_points, dir))

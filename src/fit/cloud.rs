@@ -93,9 +93,12 @@ pub(crate) const DIRECTIONS: [Vec3; 13] = [
 
 /// The points of least and greatest `p·n` for each direction `n`, as pairs
 /// `[min_0, max_0, min_1, max_1, ...]` (`f32` dot products: any input point is a valid pick).
-pub(crate) fn extremal_points(points: &[Vec3], directions: &[Vec3]) -> Vec<DVec3> {
-    let mut lo = vec![(f32::INFINITY, 0usize); directions.len()];
-    let mut hi = vec![(f32::NEG_INFINITY, 0usize); directions.len()];
+pub(crate) fn extremal_points<const N: usize>(
+    points: &[Vec3],
+    directions: &[Vec3; N],
+) -> Vec<DVec3> {
+    let mut lo = [(f32::INFINITY, 0usize); N];
+    let mut hi = [(f32::NEG_INFINITY, 0usize); N];
     for (i, p) in points.iter().enumerate() {
         for (k, n) in directions.iter().enumerate() {
             let q = p.dot(*n);

@@ -112,7 +112,10 @@ mod tests {
         let back = e.vectors * d * e.vectors.transpose();
         let norm = m.to_cols_array().iter().fold(0.0f64, |s, x| s.max(x.abs()));
         for (x, y) in back.to_cols_array().iter().zip(m.to_cols_array()) {
-            assert!((x - y).abs() <= 1e-13 * norm.max(f64::MIN_POSITIVE), "{m} -> {back}");
+            assert!(
+                (x - y).abs() <= 1e-13 * norm.max(f64::MIN_POSITIVE),
+                "{m} -> {back}"
+            );
         }
         let gram = e.vectors.transpose() * e.vectors;
         assert!(gram.abs_diff_eq(DMat3::IDENTITY, 1e-14));

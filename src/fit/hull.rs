@@ -71,7 +71,9 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
     let Some(i2) = (0..points.len()).find(|&i| !collinear(p0, p1, points[i])) else {
         return Hull::Segment(axis);
     };
-    let i2 = farthest(&|p| (p - p0).cross(axis).length_squared()).filter(|&i| !collinear(p0, p1, points[i])).unwrap_or(i2);
+    let i2 = farthest(&|p| (p - p0).cross(axis).length_squared())
+        .filter(|&i| !collinear(p0, p1, points[i]))
+        .unwrap_or(i2);
     let p2 = points[i2];
     let normal = (p1 - p0).cross(p2 - p0).normalize();
     let volume = |p: DVec3| orient3d(coord(p0), coord(p1), coord(p2), coord(p));
@@ -99,7 +101,11 @@ impl<'a> Quickhull<'a> {
     fn new(points: &'a [DVec3], [a, b, c, d]: [usize; 4]) -> Self {
         let p = |i: usize| points[i];
         // Make `d` lie below the base (a, b, c) so that all four faces turn outward.
-        let (b, c) = if above(p(a), p(b), p(c), p(d)) { (c, b) } else { (b, c) };
+        let (b, c) = if above(p(a), p(b), p(c), p(d)) {
+            (c, b)
+        } else {
+            (b, c)
+        };
         let mut hull = Self {
             points,
             faces: Vec::new(),
@@ -149,7 +155,10 @@ impl<'a> Quickhull<'a> {
         let n = (b - a).cross(c - a);
         let height = |i: usize| (self.points[i] - a).dot(n);
         let set = &self.outside[face];
-        set.iter().copied().max_by(|&i, &j| height(i).total_cmp(&height(j))).unwrap_or(set[0])
+        set.iter()
+            .copied()
+            .max_by(|&i, &j| height(i).total_cmp(&height(j)))
+            .unwrap_or(set[0])
     }
 
     /// Adds outside points until no face sees any.
@@ -178,7 +187,10 @@ impl<'a> Quickhull<'a> {
                 self.alive[f] = false;
                 orphans.append(&mut self.outside[f]);
             }
-            let new_faces: Vec<usize> = horizon.into_iter().map(|(u, v)| self.add_face([u, v, eye])).collect();
+            let new_faces: Vec<usize> = horizon
+                .into_iter()
+                .map(|(u, v)| self.add_face([u, v, eye]))
+                .collect();
             self.assign(orphans.into_iter().filter(|&i| i != eye), &new_faces);
             stack.extend(new_faces);
         }
@@ -216,6 +228,9 @@ impl<'a> Quickhull<'a> {
                 })
             })
             .collect();
-        Hull::Solid { vertices, triangles }
+        Hull::Solid {
+            vertices,
+            triangles,
+        }
     }
 }

@@ -2,6 +2,17 @@
 
 use super::bound::Bounded;
 use super::cloud::{self, DIRECTIONS, exact};
+
+/// DiTO-14's sample directions: the first 7 of [`DIRECTIONS`].
+const DITO_DIRECTIONS: [Vec3; 7] = [
+    DIRECTIONS[0],
+    DIRECTIONS[1],
+    DIRECTIONS[2],
+    DIRECTIONS[3],
+    DIRECTIONS[4],
+    DIRECTIONS[5],
+    DIRECTIONS[6],
+];
 use super::eigen::principal_axes;
 use super::hull::{Hull, convex_hull};
 use super::rect::min_area_rectangle;
@@ -149,40 +160,44 @@ fn fit_axes<const N: usize>(
     rotations: [Mat3A; N],
     center: Center,
 ) -> [Obb3; N] {
-    let axes = rotations.map(|r| [0, 1, 2].map(|k| r.col(k).as_dvec3()));
+    let axes = rotations.map(|r| r.as_dmat3().transpose());
     let mut lo = [DVec3::INFINITY; N];
     let mut hi = [DVec3::NEG_INFINITY; N];
     for &p in points {
         let p = exact(p);
         for r in 0..N {
-            let q = DVec3::from_array(axes[r].map(|a| p.dot(a)));
+            let q = axes[r] * p;
             lo[r] = lo[r].min(q);
             hi[r] = hi[r].max(q);
         }
     }
+    core::array::from_fn(|r| certified_box(rotations[r], lo[r], hi[r], bounds, center))
+}
+
+/// The certified box with axes `rotation` whose computed projection range is `[lo, hi]`
+/// (see [`fit_axes`]).
+fn certified_box(rotation: Mat3A, lo: DVec3, hi: DVec3, bounds: &Aabb3, center: Center) -> Obb3 {
+    let axes = [0, 1, 2].map(|k| rotation.col(k).as_dvec3());
     let reach = bounds.min.abs().max(bounds.max.abs()).as_dvec3();
-    core::array::from_fn(|r| {
-        let midrange: DVec3 = (0..3).map(|k| axes[r][k] * (0.5 * (lo[r][k] + hi[r][k]))).sum();
-        let c = match center {
-            Center::Midrange => midrange,
-            Center::At(c) => c,
-        };
-        let center = c.as_vec3a();
-        let cd = center.as_dvec3();
-        let half_extent = |k: usize| {
-            let cc = cd.dot(axes[r][k]);
-            Bounded {
-                value: (hi[r][k] - cc).max(cc - lo[r][k]),
-                scale: axes[r][k].abs().dot(reach + cd.abs()),
-            }
-            .upper()
-        };
-        Obb3 {
-            center,
-            half_extents: Vec3A::new(half_extent(0), half_extent(1), half_extent(2)),
-            rotation: rotations[r],
+    let c = match center {
+        Center::Midrange => (0..3).map(|k| axes[k] * (0.5 * (lo[k] + hi[k]))).sum(),
+        Center::At(c) => c,
+    };
+    let center = c.as_vec3a();
+    let cd = center.as_dvec3();
+    let half_extent = |k: usize| {
+        let cc = cd.dot(axes[k]);
+        Bounded {
+            value: (hi[k] - cc).max(cc - lo[k]),
+            scale: axes[k].abs().dot(reach + cd.abs()),
         }
-    })
+        .upper()
+    };
+    Obb3 {
+        center,
+        half_extents: Vec3A::new(half_extent(0), half_extent(1), half_extent(2)),
+        rotation,
+    }
 }
 
 /// The box of least volume, then least surface (for flat sets, whose volumes tie at 0).
@@ -193,7 +208,11 @@ fn smallest(boxes: impl IntoIterator<Item = Obb3>) -> Obb3 {
     };
     boxes
         .into_iter()
-        .min_by(|a, b| key(a).partial_cmp(&key(b)).unwrap_or(core::cmp::Ordering::Equal))
+        .min_by(|a, b| {
+            key(a)
+                .partial_cmp(&key(b))
+                .unwrap_or(core::cmp::Ordering::Equal)
+        })
         .unwrap_or(Obb3 {
             center: Vec3A::ZERO,
             half_extents: Vec3A::ZERO,
@@ -215,13 +234,25 @@ fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
 /// points as given) and the best DiTO frame.
 fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
     let pca = principal_axes(cloud::covariance(points, cloud::mean(points)));
-    let extremal = cloud::extremal_points(points, &DIRECTIONS[..7]);
+    let extremal = cloud::extremal_points(points, &DITO_DIRECTIONS);
     let dito = dito_frames(&extremal)
         .into_iter()
         .min_by(|a, b| volume_over(a, &extremal).total_cmp(&volume_over(b, &extremal)))
         .unwrap_or(pca);
-    let rotations = [DMat3::IDENTITY, pca, dito].map(to_f32);
-    smallest(fit_axes(points, bounds, rotations, Center::Midrange))
+    // The coordinate axes' projection range is the bounding box itself, exactly.
+    let aabb = certified_box(
+        Mat3A::IDENTITY,
+        bounds.min.as_dvec3(),
+        bounds.max.as_dvec3(),
+        bounds,
+        Center::Midrange,
+    );
+    let rotations = [pca, dito].map(to_f32);
+    smallest(
+        fit_axes(points, bounds, rotations, Center::Midrange)
+            .into_iter()
+            .chain([aabb]),
+    )
 }
 
 /// The extents `max − min` of the projections of `points` on the columns of `frame`.
@@ -267,7 +298,10 @@ fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
     let Some((p0, p1)) = extremal
         .chunks_exact(2)
         .map(|pair| (pair[0], pair[1]))
-        .max_by(|a, b| a.0.distance_squared(a.1).total_cmp(&b.0.distance_squared(b.1)))
+        .max_by(|a, b| {
+            a.0.distance_squared(a.1)
+                .total_cmp(&b.0.distance_squared(b.1))
+        })
     else {
         return Vec::new();
     };
@@ -347,7 +381,10 @@ fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
         let Some(unit) = n.try_normalize() else {
             continue;
         };
-        let key = (unit * f64::from(1u32 << 24)).round().as_i64vec3().to_array();
+        let key = (unit * f64::from(1u32 << 24))
+            .round()
+            .as_i64vec3()
+            .to_array();
         let entry = by_direction.entry(key).or_insert((0.0, unit));
         entry.0 += n.length();
     }
@@ -364,7 +401,10 @@ fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
 /// points projected on the plane orthogonal to the unit `normal`.
 fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
     let (e1, e2) = normal.any_orthonormal_pair();
-    let flat: Vec<DVec2> = points.iter().map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect();
+    let flat: Vec<DVec2> = points
+        .iter()
+        .map(|p| DVec2::new(p.dot(e1), p.dot(e2)))
+        .collect();
     let (side, _) = min_area_rectangle(&flat);
     let u = e1 * side.x + e2 * side.y;
     DMat3::from_cols(u, normal.cross(u), normal)
@@ -372,7 +412,8 @@ fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
 
 /// A local minimum of the volume over rotations `frame·exp(ω)` near `frame`.
 fn refine(frame: DMat3, points: &[DVec3]) -> DMat3 {
-    let rotated = |w: [f64; 3]| frame * DMat3::from_quat(DQuat::from_scaled_axis(DVec3::from_array(w)));
+    let rotated =
+        |w: [f64; 3]| frame * DMat3::from_quat(DQuat::from_scaled_axis(DVec3::from_array(w)));
     let (w, _) = compass_search(|w| volume_over(&rotated(w), points), 0.05, 1e-7, 3000);
     rotated(w)
 }

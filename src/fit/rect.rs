@@ -91,12 +91,25 @@ mod tests {
     #[test]
     fn rotated_rectangle_and_square() {
         let r = DVec2::from_angle(0.3);
-        let corners = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (0.0, 1.0), (2.0, 0.5), (1.0, 0.0)];
-        let pts: Vec<DVec2> = corners.iter().map(|&(x, y)| r.rotate(DVec2::new(x, y))).collect();
+        let corners = [
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 1.0),
+            (0.0, 1.0),
+            (2.0, 0.5),
+            (1.0, 0.0),
+        ];
+        let pts: Vec<DVec2> = corners
+            .iter()
+            .map(|&(x, y)| r.rotate(DVec2::new(x, y)))
+            .collect();
         assert_eq!(convex_hull_2d(&pts).len(), 4);
         let (dir, area) = min_area_rectangle(&pts);
         assert!((area - 4.0).abs() < 1e-12, "{area}");
-        assert!(dir.perp_dot(r).abs() < 1e-12 || dir.dot(r).abs() < 1e-12, "{dir}");
+        assert!(
+            dir.perp_dot(r).abs() < 1e-12 || dir.dot(r).abs() < 1e-12,
+            "{dir}"
+        );
         let diamond: Vec<DVec2> = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)]
             .iter()
             .map(|&(x, y)| DVec2::new(x, y))

@@ -74,8 +74,20 @@ impl Sphere {
         let face = |sign: f64| c + DVec3::splat(sign * r);
         let scale = c.abs() + DVec3::splat(r.abs());
         Aabb3::new(
-            Vec3A::from_array([0, 1, 2].map(|i| Bounded { value: face(-1.0)[i], scale: scale[i] }.lower())),
-            Vec3A::from_array([0, 1, 2].map(|i| Bounded { value: face(1.0)[i], scale: scale[i] }.upper())),
+            Vec3A::from_array([0, 1, 2].map(|i| {
+                Bounded {
+                    value: face(-1.0)[i],
+                    scale: scale[i],
+                }
+                .lower()
+            })),
+            Vec3A::from_array([0, 1, 2].map(|i| {
+                Bounded {
+                    value: face(1.0)[i],
+                    scale: scale[i],
+                }
+                .upper()
+            })),
         )
     }
 }
@@ -104,7 +116,10 @@ fn fast_center(points: &[Vec3]) -> DVec3 {
         let (far, distance2) = points
             .iter()
             .map(|&p| (exact(p), exact(p).distance_squared(c)))
-            .fold((c, 0.0), |best, next| if next.1 > best.1 { next } else { best });
+            .fold(
+                (c, 0.0),
+                |best, next| if next.1 > best.1 { next } else { best },
+            );
         if distance2 <= ball.radius2 {
             break;
         }

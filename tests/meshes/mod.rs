@@ -52,7 +52,11 @@ pub fn torus(big: f32, small: f32, around: usize, across: usize) -> Vec<Vec3> {
         for j in 0..across {
             let v = TAU * j as f32 / across as f32;
             let radial = big + small * v.cos();
-            points.push(Vec3::new(radial * u.cos(), radial * u.sin(), small * v.sin()));
+            points.push(Vec3::new(
+                radial * u.cos(),
+                radial * u.sin(),
+                small * v.sin(),
+            ));
         }
     }
     points
@@ -128,7 +132,10 @@ pub fn procedural() -> Vec<(&'static str, Vec<Vec3>)> {
     vec![
         ("sphere", uv_sphere(1.0, 16, 24)),
         ("torus", rotated(&torus(1.0, 0.3, 32, 12), tilt())),
-        ("box", rotated(&box_surface(Vec3::new(2.0, 1.0, 0.5), 6), tilt())),
+        (
+            "box",
+            rotated(&box_surface(Vec3::new(2.0, 1.0, 0.5), 6), tilt()),
+        ),
         ("cylinder", rotated(&cylinder(0.5, 2.0, 24, 4), tilt())),
     ]
 }
