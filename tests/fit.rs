@@ -281,3 +281,179 @@ fn shrunk_volumes_lose_a_vertex() {
     check_shrunk_fails::<Sphere>();
     check_shrunk_fails::<Capsule>();
 }
+
+#[test]
+fn bad_input_is_an_error() {
+    let nan = vec![Vec3::ZERO, Vec3::ONE, Vec3::new(0.0, f32::NAN, 0.0)];
+    let inf = vec![Vec3::ZERO, Vec3::new(f32::NEG_INFINITY, 0.0, 0.0)];
+    for mode in MODES {
+        assert_eq!(Obb3::fit(&[], mode), Err(FitError::Empty));
+        assert_eq!(Sphere::fit(&[], mode), Err(FitError::Empty));
+        assert_eq!(Capsule::fit(&[], mode), Err(FitError::Empty));
+        assert!(matches!(Obb3::fit(&nan, mode), Err(FitError::NonFinite { index: 2, .. })));
+        assert!(matches!(Sphere::fit(&inf, mode), Err(FitError::NonFinite { index: 1, .. })));
+        assert!(matches!(Capsule::fit(&inf, mode), Err(FitError::NonFinite { index: 1, .. })));
+    }
+    let error: Box<dyn std::error::Error> = Box::new(Obb3::fit(&nan, Fit::Fast).unwrap_err());
+    assert!(error.to_string().contains("point 2 is not finite"));
+    assert!(FitError::Empty.to_string().contains("no points"));
+    assert_eq!(Fit::default(), Fit::Fast);
+}
+
+#[test]
+fn degenerate_sets_give_flat_volumes() {
+    let p = Vec3::new(1.5, -2.25, 1e-3);
+    for mode in MODES {
+        let s = Sphere::fit(&[p, p, p], mode).unwrap();
+        assert_eq!((s.center, s.radius), (Vec3A::from(p), 0.0), "{mode:?}");
+        let c = Capsule::fit(&[p], mode).unwrap();
+        assert_eq!((c.a, c.b, c.radius), (p.into(), p.into(), 0.0), "{mode:?}");
+        let b = Obb3::fit(&[p], mode).unwrap();
+        assert!(b.half_extents.max_element() <= 1e-12, "{mode:?} {b:?}");
+
+        // Collinear: the box and the capsule are thin needles along the line.
+        let line = meshes::rotated(&meshes::collinear(15), meshes::tilt());
+        let b = Obb3::fit(&line, mode).unwrap();
+        let mut h = b.half_extents.to_array();
+        h.sort_by(f32::total_cmp);
+        assert!(h[1] <= 1e-5 * h[2], "{mode:?} {b:?}");
+        let c = Capsule::fit(&line, mode).unwrap();
+        assert!(c.radius <= 1e-5 * c.a.distance(c.b), "{mode:?} {c:?}");
+    }
+    // Exactly planar: the tight box is the plane's minimum-area rectangle, of no thickness.
+    let plane = meshes::planar(12);
+    let tight = Obb3::fit(&plane, Fit::Tight).unwrap();
+    assert!(tight.half_extents.min_element() <= 1e-12, "{tight:?}");
+    let area = |b: &Obb3| {
+        let mut h = b.half_extents.to_array();
+        h.sort_by(f32::total_cmp);
+        4.0 * h[1] * h[2]
+    };
+    let swept = (0..3600)
+        .map(|i| {
+            let r = Mat3A::from_rotation_z(i as f32 * std::f32::consts::FRAC_PI_2 / 3600.0);
+            area(&Obb3::from_axes(&plane, r).unwrap())
+        })
+        .fold(f32::INFINITY, f32::min);
+    assert!(area(&tight) <= swept * (1.0 + 1e-5), "{} vs swept {swept}", area(&tight));
+    assert!(area(&tight) >= swept * (1.0 - 1e-3));
+}
+
+#[test]
+fn duplicates_change_nothing_for_the_distinct_fits() {
+    let spot = meshes::spot();
+    let mut twice = spot.clone();
+    twice.extend(spot.iter().rev());
+    assert_eq!(Obb3::fit(&spot, Fit::Pca), Obb3::fit(&twice, Fit::Pca));
+    assert_eq!(Sphere::fit(&spot, Fit::Pca), Sphere::fit(&twice, Fit::Pca));
+    assert_eq!(Sphere::fit(&spot, Fit::Tight), Sphere::fit(&twice, Fit::Tight));
+    assert_eq!(Capsule::fit(&spot, Fit::Pca), Capsule::fit(&twice, Fit::Pca));
+}
+
+/// The fast box is never worse than the AABB nor the PCA axes with a midrange center; the
+/// tight box never worse than the fast one; the tight capsule never worse than the others.
+#[test]
+fn each_mode_is_at_least_as_good_as_its_baselines() {
+    for (name, points) in meshes::real().into_iter().chain(meshes::procedural()) {
+        let pca = Obb3::fit(&points, Fit::Pca).unwrap();
+        let fast = Obb3::fit(&points, Fit::Fast).unwrap().volume();
+        let aabb = Obb3::from_axes(&points, Mat3A::IDENTITY).unwrap().volume();
+        let midrange = Obb3::from_axes(&points, pca.rotation).unwrap().volume();
+        assert!(fast <= aabb && fast <= midrange, "{name}: {fast} vs {aabb}, {midrange}");
+        assert!(midrange <= pca.volume(), "{name}");
+        let tight = Obb3::fit(&points, Fit::Tight).unwrap().volume();
+        assert!(tight <= fast, "{name}: {tight} > {fast}");
+        let capsule = |mode| Capsule::fit(&points, mode).unwrap().volume();
+        let tight_capsule = capsule(Fit::Tight);
+        assert!(tight_capsule <= capsule(Fit::Fast) * (1.0 + 1e-6), "{name}");
+        assert!(tight_capsule <= capsule(Fit::Pca) * (1.0 + 1e-6), "{name}");
+        let sphere = |mode| Sphere::fit(&points, mode).unwrap().radius;
+        assert!(sphere(Fit::Tight) <= sphere(Fit::Fast) * (1.0 + 1e-6), "{name}");
+        assert!(sphere(Fit::Fast) <= sphere(Fit::Tight) * 1.05f32.cbrt(), "{name}");
+        assert!(sphere(Fit::Tight) <= sphere(Fit::Pca) * (1.0 + 1e-6), "{name}");
+    }
+}
+
+/// Shapes whose smallest volumes are known.
+#[test]
+fn known_answers() {
+    // A turned box surface: the tight box is the box, 4 × 2 × 1.
+    let q = meshes::tilt();
+    let turned = meshes::rotated(&meshes::box_surface(Vec3::new(2.0, 1.0, 0.5), 6), q);
+    let tight = Obb3::fit(&turned, Fit::Tight).unwrap();
+    assert!((tight.volume() / 8.0 - 1.0).abs() <= 1e-5, "{tight:?}");
+    // Cube corners ±1, turned: the smallest ball has radius √3.
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| q * Vec3::new([-1.0, 1.0][k & 1], [-1.0, 1.0][k >> 1 & 1], [-1.0, 1.0][k >> 2 & 1]))
+        .collect();
+    let ball = Sphere::fit(&corners, Fit::Tight).unwrap();
+    assert!((ball.radius / 3f32.sqrt() - 1.0).abs() <= 1e-6, "{ball:?}");
+    // A UV sphere: its own radius, for the exact and the fast fits.
+    for mode in [Fit::Fast, Fit::Tight] {
+        let r = Sphere::fit(&meshes::uv_sphere(2.0, 16, 24), mode).unwrap().radius;
+        assert!((r / 2.0 - 1.0).abs() <= 1e-6, "{mode:?} {r}");
+    }
+    // A capsule-shaped cloud (a cylinder of radius 0.5 and half-height 2 with hemispheres):
+    // the tight capsule is that capsule.
+    let mut pill = meshes::cylinder(0.5, 2.0, 24, 4);
+    for p in meshes::uv_sphere(0.5, 12, 24) {
+        pill.push(p + Vec3::Z * 2.0f32.copysign(p.z));
+    }
+    let pill = meshes::rotated(&pill, q);
+    let c = Capsule::fit(&pill, Fit::Tight).unwrap();
+    let exact = std::f32::consts::PI * 0.25 * (4.0 + 4.0 / 3.0 * 0.5);
+    assert!((c.volume() / exact - 1.0).abs() <= 1e-3, "{c:?}: {} vs {exact}", c.volume());
+}
+
+/// Scaling by a power of two scales every fit exactly; other scales and turns change the
+/// volumes of the fits that do not depend on the coordinate axes by at most 1e-5 (the
+/// input's own rounding to `f32`).
+#[test]
+fn invariant_under_scale_and_rotation() {
+    let spot = meshes::spot();
+    for mode in MODES {
+        let doubled = meshes::scaled(&spot, 1024.0);
+        let (b, b2) = (Obb3::fit(&spot, mode).unwrap(), Obb3::fit(&doubled, mode).unwrap());
+        assert_eq!((b.center * 1024.0, b.half_extents * 1024.0), (b2.center, b2.half_extents), "{mode:?}");
+        let (s, s2) = (Sphere::fit(&spot, mode).unwrap(), Sphere::fit(&doubled, mode).unwrap());
+        assert_eq!((s.center * 1024.0, s.radius * 1024.0), (s2.center, s2.radius), "{mode:?}");
+        let (c, c2) = (Capsule::fit(&spot, mode).unwrap(), Capsule::fit(&doubled, mode).unwrap());
+        assert_eq!((c.a * 1024.0, c.radius * 1024.0), (c2.a, c2.radius), "{mode:?}");
+    }
+    let relative = |a: f32, b: f32| (a / b - 1.0).abs();
+    for scale in [1e-4f32, 0.37, 1e4] {
+        let s = meshes::scaled(&spot, scale);
+        let cube = scale.powi(3);
+        for mode in [Fit::Pca, Fit::Tight] {
+            let obb = Obb3::fit(&s, mode).unwrap().volume() / cube;
+            assert!(relative(obb, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5, "{mode:?} {scale}");
+        }
+        let r = Sphere::fit(&s, Fit::Tight).unwrap().radius / scale;
+        assert!(relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5, "{scale}");
+    }
+    for q in [meshes::tilt(), Quat::from_rotation_y(2.0), Quat::from_rotation_x(-0.9)] {
+        let turned = meshes::rotated(&spot, q);
+        for mode in [Fit::Pca, Fit::Tight] {
+            let v = Obb3::fit(&turned, mode).unwrap().volume();
+            assert!(relative(v, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5, "{mode:?} {q}");
+        }
+        let r = Sphere::fit(&turned, Fit::Tight).unwrap().radius;
+        assert!(relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5, "{q}");
+    }
+}
+
+/// Hand-made boxes: a rotation off orthonormal, far from the origin; its AABB still
+/// contains the exact parallelepiped, and a singular rotation gives the whole space.
+#[test]
+fn aabb_of_any_box_contains_it() {
+    let skewed = Obb3 {
+        center: Vec3A::new(1e4, -3.0, 0.5),
+        half_extents: Vec3A::new(1.0, 2.0, 1e-3),
+        rotation: Mat3A::from_cols(Vec3A::new(1.0, 0.001, 0.0), Vec3A::new(0.0, 0.999, 0.002), Vec3A::new(0.01, 0.0, 1.0)),
+    };
+    assert!(skewed.aabb_holds_exactly());
+    let flat = Obb3 { rotation: Mat3A::from_cols(Vec3A::X, Vec3A::X, Vec3A::Z), ..skewed };
+    assert_eq!(flat.aabb(), Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY));
+    assert!(!Obb3 { center: Vec3A::NAN, ..skewed }.aabb().is_valid());
+    assert!(!skewed.contains_point(Vec3A::NAN));
+}
