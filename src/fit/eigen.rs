@@ -145,4 +145,31 @@ mod tests {
             }
         }
     }
+
+    /// Eigenvalues scale with the matrix and turn with it: checked to 1e-5 relative for
+    /// scales 1e-4..1e4 and a rotation, on distinct, repeated and degenerate spectra.
+    #[test]
+    fn invariant_under_scale_and_rotation() {
+        let base = DMat3::from_cols_array(&[4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 1.0]);
+        let planar = DMat3::from_cols_array(&[2.0, 1.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 0.0]);
+        let r = DMat3::from_euler(glam::EulerRot::ZYX, 1.0, 0.4, -2.2);
+        for m in [base, planar, DMat3::IDENTITY] {
+            let reference = symmetric_eigen(m);
+            for scale in [1e-4, 0.3, 1.0, 7.0, 1e4] {
+                let e = check(r * (m * scale) * r.transpose());
+                for k in 0..3 {
+                    let want = reference.values[k] * scale;
+                    assert!((e.values[k] - want).abs() <= 1e-5 * reference.values[0] * scale);
+                    // A distinct eigenvalue's vector turns with the matrix (up to sign).
+                    let distinct = (0..3).all(|j| {
+                        j == k || (reference.values[j] - reference.values[k]).abs() > 1e-3
+                    });
+                    if distinct {
+                        let turned = r * reference.vectors.col(k);
+                        assert!(turned.dot(e.vectors.col(k)).abs() >= 1.0 - 1e-10);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -234,3 +234,44 @@ impl<'a> Quickhull<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_a_cube_with_inner_and_face_points() {
+        let mut points: Vec<DVec3> = (0..8)
+            .map(|k| DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64))
+            .collect();
+        points.extend([
+            DVec3::splat(0.5),
+            DVec3::new(0.5, 0.5, 1.0),
+            DVec3::new(0.25, 0.0, 0.5),
+        ]);
+        let Hull::Solid {
+            vertices,
+            triangles,
+        } = convex_hull(&points)
+        else {
+            panic!("a cube is solid");
+        };
+        assert_eq!(vertices.len(), 8);
+        assert_eq!(triangles.len(), 12);
+        for t in &triangles {
+            let [a, b, c] = t.map(|i| vertices[i]);
+            assert!(
+                points.iter().all(|&p| !above(a, b, c, p)),
+                "every point below each face"
+            );
+        }
+        assert!(matches!(convex_hull(&points[..4]), Hull::Planar(n) if n.z.abs() == 1.0));
+        let line = [
+            DVec3::ZERO,
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-2.0, -4.0, -6.0),
+        ];
+        assert!(matches!(convex_hull(&line), Hull::Segment(_)));
+        assert!(matches!(convex_hull(&[DVec3::ONE]), Hull::Point));
+    }
+}
