@@ -146,37 +146,28 @@ fn ball_lower_bound(points: &[Vec3], center: DVec3) -> f64 {
 }
 
 /// Nonnegative weights summing to 1 whose combination of `set` is closest to the origin
-/// (least squares in the affine hull), if they are all nonnegative.
+/// (least squares in the affine hull, normal equations padded to 3×3), if they are all
+/// nonnegative.
 fn affine_weights(set: &[DVec3]) -> Option<Vec<f64>> {
     let (p0, rest) = set.split_first()?;
-    let edges: Vec<DVec3> = rest.iter().map(|p| *p - *p0).collect();
-    let k = edges.len();
-    // Normal equations  Σ_j (e_i·e_j) μ_j = −e_i·p0, weights (1 − Σμ, μ...).
-    let mut m = vec![vec![0.0; k + 1]; k];
-    for i in 0..k {
-        for j in 0..k {
-            m[i][j] = edges[i].dot(edges[j]);
-        }
-        m[i][k] = -edges[i].dot(*p0);
-    }
-    for c in 0..k {
-        let pivot = (c..k).max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))?;
-        m.swap(c, pivot);
-        if m[c][c].abs() < 1e-300 {
-            return None;
-        }
-        for r in 0..k {
-            if r != c {
-                let f = m[r][c] / m[c][c];
-                for x in c..=k {
-                    m[r][x] -= f * m[c][x];
-                }
+    let k = rest.len();
+    let edge = |i: usize| rest.get(i).map_or(DVec3::ZERO, |p| *p - *p0);
+    let gram = DMat3::from_cols_array_2d(&std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            if i < k && j < k {
+                edge(i).dot(edge(j))
+            } else {
+                f64::from(u8::from(i == j))
             }
-        }
+        })
+    }));
+    if gram.determinant().abs() <= 1e-300 {
+        return None;
     }
-    let mu: Vec<f64> = (0..k).map(|i| m[i][k] / m[i][i]).collect();
+    let mu = gram.inverse() * DVec3::from_array(std::array::from_fn(|i| -edge(i).dot(*p0)));
+    let mu = &mu.to_array()[..k];
     let weights: Vec<f64> = std::iter::once(1.0 - mu.iter().sum::<f64>())
-        .chain(mu)
+        .chain(mu.iter().copied())
         .collect();
     weights.iter().all(|&w| w >= 0.0).then_some(weights)
 }

@@ -290,9 +290,18 @@ fn bad_input_is_an_error() {
         assert_eq!(Obb3::fit(&[], mode), Err(FitError::Empty));
         assert_eq!(Sphere::fit(&[], mode), Err(FitError::Empty));
         assert_eq!(Capsule::fit(&[], mode), Err(FitError::Empty));
-        assert!(matches!(Obb3::fit(&nan, mode), Err(FitError::NonFinite { index: 2, .. })));
-        assert!(matches!(Sphere::fit(&inf, mode), Err(FitError::NonFinite { index: 1, .. })));
-        assert!(matches!(Capsule::fit(&inf, mode), Err(FitError::NonFinite { index: 1, .. })));
+        assert!(matches!(
+            Obb3::fit(&nan, mode),
+            Err(FitError::NonFinite { index: 2, .. })
+        ));
+        assert!(matches!(
+            Sphere::fit(&inf, mode),
+            Err(FitError::NonFinite { index: 1, .. })
+        ));
+        assert!(matches!(
+            Capsule::fit(&inf, mode),
+            Err(FitError::NonFinite { index: 1, .. })
+        ));
     }
     let error: Box<dyn std::error::Error> = Box::new(Obb3::fit(&nan, Fit::Fast).unwrap_err());
     assert!(error.to_string().contains("point 2 is not finite"));
@@ -335,7 +344,11 @@ fn degenerate_sets_give_flat_volumes() {
             area(&Obb3::from_axes(&plane, r).unwrap())
         })
         .fold(f32::INFINITY, f32::min);
-    assert!(area(&tight) <= swept * (1.0 + 1e-5), "{} vs swept {swept}", area(&tight));
+    assert!(
+        area(&tight) <= swept * (1.0 + 1e-5),
+        "{} vs swept {swept}",
+        area(&tight)
+    );
     assert!(area(&tight) >= swept * (1.0 - 1e-3));
 }
 
@@ -346,8 +359,14 @@ fn duplicates_change_nothing_for_the_distinct_fits() {
     twice.extend(spot.iter().rev());
     assert_eq!(Obb3::fit(&spot, Fit::Pca), Obb3::fit(&twice, Fit::Pca));
     assert_eq!(Sphere::fit(&spot, Fit::Pca), Sphere::fit(&twice, Fit::Pca));
-    assert_eq!(Sphere::fit(&spot, Fit::Tight), Sphere::fit(&twice, Fit::Tight));
-    assert_eq!(Capsule::fit(&spot, Fit::Pca), Capsule::fit(&twice, Fit::Pca));
+    assert_eq!(
+        Sphere::fit(&spot, Fit::Tight),
+        Sphere::fit(&twice, Fit::Tight)
+    );
+    assert_eq!(
+        Capsule::fit(&spot, Fit::Pca),
+        Capsule::fit(&twice, Fit::Pca)
+    );
 }
 
 /// The fast box is never worse than the AABB nor the PCA axes with a midrange center; the
@@ -359,7 +378,10 @@ fn each_mode_is_at_least_as_good_as_its_baselines() {
         let fast = Obb3::fit(&points, Fit::Fast).unwrap().volume();
         let aabb = Obb3::from_axes(&points, Mat3A::IDENTITY).unwrap().volume();
         let midrange = Obb3::from_axes(&points, pca.rotation).unwrap().volume();
-        assert!(fast <= aabb && fast <= midrange, "{name}: {fast} vs {aabb}, {midrange}");
+        assert!(
+            fast <= aabb && fast <= midrange,
+            "{name}: {fast} vs {aabb}, {midrange}"
+        );
         assert!(midrange <= pca.volume(), "{name}");
         let tight = Obb3::fit(&points, Fit::Tight).unwrap().volume();
         assert!(tight <= fast, "{name}: {tight} > {fast}");
@@ -368,9 +390,18 @@ fn each_mode_is_at_least_as_good_as_its_baselines() {
         assert!(tight_capsule <= capsule(Fit::Fast) * (1.0 + 1e-6), "{name}");
         assert!(tight_capsule <= capsule(Fit::Pca) * (1.0 + 1e-6), "{name}");
         let sphere = |mode| Sphere::fit(&points, mode).unwrap().radius;
-        assert!(sphere(Fit::Tight) <= sphere(Fit::Fast) * (1.0 + 1e-6), "{name}");
-        assert!(sphere(Fit::Fast) <= sphere(Fit::Tight) * 1.05f32.cbrt(), "{name}");
-        assert!(sphere(Fit::Tight) <= sphere(Fit::Pca) * (1.0 + 1e-6), "{name}");
+        assert!(
+            sphere(Fit::Tight) <= sphere(Fit::Fast) * (1.0 + 1e-6),
+            "{name}"
+        );
+        assert!(
+            sphere(Fit::Fast) <= sphere(Fit::Tight) * 1.05f32.cbrt(),
+            "{name}"
+        );
+        assert!(
+            sphere(Fit::Tight) <= sphere(Fit::Pca) * (1.0 + 1e-6),
+            "{name}"
+        );
     }
 }
 
@@ -384,13 +415,21 @@ fn known_answers() {
     assert!((tight.volume() / 8.0 - 1.0).abs() <= 1e-5, "{tight:?}");
     // Cube corners ±1, turned: the smallest ball has radius √3.
     let corners: Vec<Vec3> = (0..8)
-        .map(|k| q * Vec3::new([-1.0, 1.0][k & 1], [-1.0, 1.0][k >> 1 & 1], [-1.0, 1.0][k >> 2 & 1]))
+        .map(|k| {
+            q * Vec3::new(
+                [-1.0, 1.0][k & 1],
+                [-1.0, 1.0][k >> 1 & 1],
+                [-1.0, 1.0][k >> 2 & 1],
+            )
+        })
         .collect();
     let ball = Sphere::fit(&corners, Fit::Tight).unwrap();
     assert!((ball.radius / 3f32.sqrt() - 1.0).abs() <= 1e-6, "{ball:?}");
     // A UV sphere: its own radius, for the exact and the fast fits.
     for mode in [Fit::Fast, Fit::Tight] {
-        let r = Sphere::fit(&meshes::uv_sphere(2.0, 16, 24), mode).unwrap().radius;
+        let r = Sphere::fit(&meshes::uv_sphere(2.0, 16, 24), mode)
+            .unwrap()
+            .radius;
         assert!((r / 2.0 - 1.0).abs() <= 1e-6, "{mode:?} {r}");
     }
     // A capsule-shaped cloud (a cylinder of radius 0.5 and half-height 2 with hemispheres):
@@ -402,7 +441,11 @@ fn known_answers() {
     let pill = meshes::rotated(&pill, q);
     let c = Capsule::fit(&pill, Fit::Tight).unwrap();
     let exact = std::f32::consts::PI * 0.25 * (4.0 + 4.0 / 3.0 * 0.5);
-    assert!((c.volume() / exact - 1.0).abs() <= 1e-3, "{c:?}: {} vs {exact}", c.volume());
+    assert!(
+        (c.volume() / exact - 1.0).abs() <= 1e-3,
+        "{c:?}: {} vs {exact}",
+        c.volume()
+    );
 }
 
 /// Scaling by a power of two scales every fit exactly; other scales and turns change the
@@ -413,12 +456,33 @@ fn invariant_under_scale_and_rotation() {
     let spot = meshes::spot();
     for mode in MODES {
         let doubled = meshes::scaled(&spot, 1024.0);
-        let (b, b2) = (Obb3::fit(&spot, mode).unwrap(), Obb3::fit(&doubled, mode).unwrap());
-        assert_eq!((b.center * 1024.0, b.half_extents * 1024.0), (b2.center, b2.half_extents), "{mode:?}");
-        let (s, s2) = (Sphere::fit(&spot, mode).unwrap(), Sphere::fit(&doubled, mode).unwrap());
-        assert_eq!((s.center * 1024.0, s.radius * 1024.0), (s2.center, s2.radius), "{mode:?}");
-        let (c, c2) = (Capsule::fit(&spot, mode).unwrap(), Capsule::fit(&doubled, mode).unwrap());
-        assert_eq!((c.a * 1024.0, c.radius * 1024.0), (c2.a, c2.radius), "{mode:?}");
+        let (b, b2) = (
+            Obb3::fit(&spot, mode).unwrap(),
+            Obb3::fit(&doubled, mode).unwrap(),
+        );
+        assert_eq!(
+            (b.center * 1024.0, b.half_extents * 1024.0),
+            (b2.center, b2.half_extents),
+            "{mode:?}"
+        );
+        let (s, s2) = (
+            Sphere::fit(&spot, mode).unwrap(),
+            Sphere::fit(&doubled, mode).unwrap(),
+        );
+        assert_eq!(
+            (s.center * 1024.0, s.radius * 1024.0),
+            (s2.center, s2.radius),
+            "{mode:?}"
+        );
+        let (c, c2) = (
+            Capsule::fit(&spot, mode).unwrap(),
+            Capsule::fit(&doubled, mode).unwrap(),
+        );
+        assert_eq!(
+            (c.a * 1024.0, c.radius * 1024.0),
+            (c2.a, c2.radius),
+            "{mode:?}"
+        );
     }
     let relative = |a: f32, b: f32| (a / b - 1.0).abs();
     for scale in [1e-4f32, 0.37, 1e4] {
@@ -426,19 +490,35 @@ fn invariant_under_scale_and_rotation() {
         let cube = scale.powi(3);
         for mode in [Fit::Pca, Fit::Tight] {
             let obb = Obb3::fit(&s, mode).unwrap().volume() / cube;
-            assert!(relative(obb, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5, "{mode:?} {scale}");
+            assert!(
+                relative(obb, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5,
+                "{mode:?} {scale}"
+            );
         }
         let r = Sphere::fit(&s, Fit::Tight).unwrap().radius / scale;
-        assert!(relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5, "{scale}");
+        assert!(
+            relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5,
+            "{scale}"
+        );
     }
-    for q in [meshes::tilt(), Quat::from_rotation_y(2.0), Quat::from_rotation_x(-0.9)] {
+    for q in [
+        meshes::tilt(),
+        Quat::from_rotation_y(2.0),
+        Quat::from_rotation_x(-0.9),
+    ] {
         let turned = meshes::rotated(&spot, q);
         for mode in [Fit::Pca, Fit::Tight] {
             let v = Obb3::fit(&turned, mode).unwrap().volume();
-            assert!(relative(v, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5, "{mode:?} {q}");
+            assert!(
+                relative(v, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5,
+                "{mode:?} {q}"
+            );
         }
         let r = Sphere::fit(&turned, Fit::Tight).unwrap().radius;
-        assert!(relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5, "{q}");
+        assert!(
+            relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5,
+            "{q}"
+        );
     }
 }
 
@@ -449,11 +529,28 @@ fn aabb_of_any_box_contains_it() {
     let skewed = Obb3 {
         center: Vec3A::new(1e4, -3.0, 0.5),
         half_extents: Vec3A::new(1.0, 2.0, 1e-3),
-        rotation: Mat3A::from_cols(Vec3A::new(1.0, 0.001, 0.0), Vec3A::new(0.0, 0.999, 0.002), Vec3A::new(0.01, 0.0, 1.0)),
+        rotation: Mat3A::from_cols(
+            Vec3A::new(1.0, 0.001, 0.0),
+            Vec3A::new(0.0, 0.999, 0.002),
+            Vec3A::new(0.01, 0.0, 1.0),
+        ),
     };
     assert!(skewed.aabb_holds_exactly());
-    let flat = Obb3 { rotation: Mat3A::from_cols(Vec3A::X, Vec3A::X, Vec3A::Z), ..skewed };
-    assert_eq!(flat.aabb(), Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY));
-    assert!(!Obb3 { center: Vec3A::NAN, ..skewed }.aabb().is_valid());
+    let flat = Obb3 {
+        rotation: Mat3A::from_cols(Vec3A::X, Vec3A::X, Vec3A::Z),
+        ..skewed
+    };
+    assert_eq!(
+        flat.aabb(),
+        Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY)
+    );
+    assert!(
+        !Obb3 {
+            center: Vec3A::NAN,
+            ..skewed
+        }
+        .aabb()
+        .is_valid()
+    );
     assert!(!skewed.contains_point(Vec3A::NAN));
 }

@@ -103,12 +103,11 @@ fn solve(g: &mut [Vec<f64>]) -> Vec<f64> {
         };
         used[r] = true;
         pivot_of[col] = Some(r);
-        for other in 0..k {
-            if other != r {
-                let f = g[other][col] / g[r][col];
-                for c in col..=k {
-                    g[other][c] -= f * g[r][c];
-                }
+        let pivot = g[r].clone();
+        for (_, row) in g.iter_mut().enumerate().filter(|(other, _)| *other != r) {
+            let f = row[col] / pivot[col];
+            for (x, p) in row[col..].iter_mut().zip(&pivot[col..]) {
+                *x -= f * p;
             }
         }
     }

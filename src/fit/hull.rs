@@ -203,11 +203,12 @@ impl<'a> Quickhull<'a> {
         while let Some(f) = walk.pop() {
             let tri = self.faces[f];
             for k in 0..3 {
-                if let Some(&g) = self.edges.get(&(tri[(k + 1) % 3], tri[k])) {
-                    if !visible.contains(&g) && self.sees(g, eye) {
-                        visible.insert(g);
-                        walk.push(g);
-                    }
+                if let Some(&g) = self.edges.get(&(tri[(k + 1) % 3], tri[k]))
+                    && !visible.contains(&g)
+                    && self.sees(g, eye)
+                {
+                    visible.insert(g);
+                    walk.push(g);
                 }
             }
         }
