@@ -172,33 +172,42 @@ fn affine_weights(set: &[DVec3]) -> Option<Vec<f64>> {
     weights.iter().all(|&w| w >= 0.0).then_some(weights)
 }
 
-fn obb_rows(points: &[Vec3]) -> Vec<Row> {
-    let mut rows: Vec<Row> = MODES
+/// One timed row per mode; `fit` returns the fitted volume.
+fn mode_rows(shape: &'static str, fit: impl Fn(Fit) -> f32) -> Vec<Row> {
+    MODES
         .iter()
         .map(|&mode| Row {
-            shape: "OBB",
+            shape,
             method: format!("{mode:?}"),
-            volume: f64::from(Obb3::fit(points, mode).unwrap().volume()),
-            time: Some(time(|| Obb3::fit(points, mode))),
+            volume: f64::from(fit(mode)),
+            time: Some(time(|| fit(mode))),
         })
-        .collect();
+        .collect()
+}
+
+/// An untimed reference row.
+fn reference(shape: &'static str, method: &str, volume: f64) -> Row {
+    Row {
+        shape,
+        method: method.into(),
+        volume,
+        time: None,
+    }
+}
+
+fn obb_rows(points: &[Vec3]) -> Vec<Row> {
+    let mut rows = mode_rows("OBB", |mode| Obb3::fit(points, mode).unwrap().volume());
     let pca = Obb3::fit(points, Fit::Pca).unwrap();
     let midrange = Obb3::from_axes(points, pca.rotation).unwrap();
     let aabb = bvkit::Aabb3::from_points(points.iter().map(|&p| p.into()));
     let (_, cuboid) = parry3d::utils::obb(points);
     rows.extend([
-        Row {
-            shape: "OBB",
-            method: "PCA axes, midrange center".into(),
-            volume: f64::from(midrange.volume()),
-            time: None,
-        },
-        Row {
-            shape: "OBB",
-            method: "AABB".into(),
-            volume: f64::from(aabb.volume()),
-            time: None,
-        },
+        reference(
+            "OBB",
+            "PCA axes, midrange center",
+            f64::from(midrange.volume()),
+        ),
+        reference("OBB", "AABB", f64::from(aabb.volume())),
         Row {
             shape: "OBB",
             method: "parry3d utils::obb".into(),
@@ -206,26 +215,13 @@ fn obb_rows(points: &[Vec3]) -> Vec<Row> {
                 * f64::from(cuboid.half_extents.x * cuboid.half_extents.y * cuboid.half_extents.z),
             time: Some(time(|| parry3d::utils::obb(points))),
         },
-        Row {
-            shape: "OBB",
-            method: "exhaustive search".into(),
-            volume: exhaustive_obb(points),
-            time: None,
-        },
+        reference("OBB", "exhaustive search", exhaustive_obb(points)),
     ]);
     rows
 }
 
 fn sphere_rows(points: &[Vec3]) -> Vec<Row> {
-    let mut rows: Vec<Row> = MODES
-        .iter()
-        .map(|&mode| Row {
-            shape: "sphere",
-            method: format!("{mode:?}"),
-            volume: f64::from(Sphere::fit(points, mode).unwrap().volume()),
-            time: Some(time(|| Sphere::fit(points, mode))),
-        })
-        .collect();
+    let mut rows = mode_rows("sphere", |mode| Sphere::fit(points, mode).unwrap().volume());
     let parry = parry3d::bounding_volume::details::point_cloud_bounding_sphere(points);
     rows.push(Row {
         shape: "sphere",
@@ -239,15 +235,9 @@ fn sphere_rows(points: &[Vec3]) -> Vec<Row> {
 }
 
 fn capsule_rows(points: &[Vec3]) -> Vec<Row> {
-    MODES
-        .iter()
-        .map(|&mode| Row {
-            shape: "capsule",
-            method: format!("{mode:?}"),
-            volume: f64::from(Capsule::fit(points, mode).unwrap().volume()),
-            time: Some(time(|| Capsule::fit(points, mode))),
-        })
-        .collect()
+    mode_rows("capsule", |mode| {
+        Capsule::fit(points, mode).unwrap().volume()
+    })
 }
 
 /// One target's verdict.

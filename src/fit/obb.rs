@@ -20,7 +20,7 @@ use super::search::compass_search;
 use super::{Fit, FitError};
 use crate::Aabb3;
 use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 /// An oriented box: the points `x` with `|(x − center)·axis_k| <= half_extents[k]` for each
 /// column `axis_k` of `rotation`.
@@ -374,7 +374,7 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
 /// [`MAX_FACE_NORMALS`].
 fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
-    let mut by_direction: HashMap<[i64; 3], (f64, DVec3)> = HashMap::new();
+    let mut by_direction: BTreeMap<[i64; 3], (f64, DVec3)> = BTreeMap::new();
     for t in triangles {
         let [a, b, c] = t.map(|i| vertices[i]);
         let n = (b - a).cross(c - a);
