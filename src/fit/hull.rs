@@ -169,7 +169,7 @@ impl<'a> Quickhull<'a> {
                 continue;
             }
             let eye = self.eye(face);
-            let visible = self.visible_from(face, eye);
+            let (visible, is_visible) = self.visible_from(face, eye);
             let mut horizon = Vec::new();
             let mut orphans = Vec::new();
             for &f in &visible {
@@ -177,7 +177,7 @@ impl<'a> Quickhull<'a> {
                 for k in 0..3 {
                     let (u, v) = (tri[k], tri[(k + 1) % 3]);
                     let across = self.edges.get(&(v, u)).copied();
-                    if across.is_some_and(|g| !visible.contains(&g)) {
+                    if across.is_some_and(|g| !is_visible.contains(&g)) {
                         horizon.push((u, v));
                     }
                 }
@@ -196,23 +196,25 @@ impl<'a> Quickhull<'a> {
         }
     }
 
-    /// The faces that see `eye`: a connected disk, found by a walk from `start`.
-    fn visible_from(&self, start: usize, eye: usize) -> HashSet<usize> {
-        let mut visible = HashSet::from([start]);
-        let mut walk = vec![start];
-        while let Some(f) = walk.pop() {
+    /// The faces that see `eye`: a connected disk, found by a walk from `start`; in walk
+    /// order (so the hull is the same on every run) and as a set.
+    fn visible_from(&self, start: usize, eye: usize) -> (Vec<usize>, HashSet<usize>) {
+        let (mut order, mut seen) = (vec![start], HashSet::from([start]));
+        let mut next = 0;
+        while let Some(&f) = order.get(next) {
+            next += 1;
             let tri = self.faces[f];
             for k in 0..3 {
                 if let Some(&g) = self.edges.get(&(tri[(k + 1) % 3], tri[k]))
-                    && !visible.contains(&g)
+                    && !seen.contains(&g)
                     && self.sees(g, eye)
                 {
-                    visible.insert(g);
-                    walk.push(g);
+                    seen.insert(g);
+                    order.push(g);
                 }
             }
         }
-        visible
+        (order, seen)
     }
 
     fn into_hull(self) -> Hull {
