@@ -67,6 +67,7 @@ mod batch;
 mod block;
 mod error;
 mod extended;
+mod fit;
 mod kernel;
 mod lane;
 pub mod method;
@@ -78,6 +79,7 @@ pub mod transform;
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
 pub use error::TransformError;
+pub use fit::{Capsule, Fit, FitError, Obb3, Sphere};
 pub use method::{Method, Rounding};
 pub use simd::Backend;
 pub use transform::{

@@ -1,0 +1,106 @@
+//! Certified rounding: `f64` evaluations with a proven error bound, rounded outward to `f32`.
+//!
+//! Every fit computes in `f64` on the exact values of the `f32` inputs and then certifies
+//! its `f32` result against the same inputs. The certificates all rest on one lemma.
+//!
+//! **Lemma.** Let `x` be a real quantity and `value` its `f64` evaluation by at most 8
+//! roundings of `+ − × √` on exact `f32` data, whose error analysis gives
+//! `|x − value| ≤ γ(8)·(|value| + scale)` for a known `scale >= 0`, with `u = 2^-53` and
+//! `γ(n) = n·u / (1 − n·u) < 2^-49.9`. Then [`Bounded::upper`] `>= x` and
+//! [`Bounded::lower`] `<= x`.
+//!
+//! *Proof.* The pad `SLACK·(|value| + scale)` with `SLACK = 2^-48` is computed with two
+//! roundings, so it is at least `2^-48·(1 − 2u)·(|value| + scale) > γ(8)·(|value| + scale) + u·|value + pad|`:
+//! it covers the evaluation error and the rounding of the final sum. `round_up` (`round_down`)
+//! then returns an `f32` on the far side of that sum. No `f64` step can underflow or overflow:
+//! products of `f32` values lie in `[2^-298, 2^256]`, well inside `f64`'s normal range. ∎
+//!
+//! Callers name the roundings of their expression next to each use.
+
+use glam::DVec3;
+
+/// The relative pad `2^-48`, four times the worst error `γ(8) < 2^-49.9` of the evaluations.
+pub(crate) const SLACK: f64 = 1.0 / (1u64 << 48) as f64;
+
+/// The smallest `f32` at or above `x` (`+inf` above `f32::MAX`).
+#[inline]
+#[must_use]
+pub(crate) fn round_up(x: f64) -> f32 {
+    let nearest = x as f32;
+    if f64::from(nearest) < x {
+        nearest.next_up()
+    } else {
+        nearest
+    }
+}
+
+/// The largest `f32` at or below `x` (`-inf` below `-f32::MAX`).
+#[inline]
+#[must_use]
+pub(crate) fn round_down(x: f64) -> f32 {
+    -round_up(-x)
+}
+
+/// An `f64` evaluation `value` of a real `x` with `|x − value| ≤ γ(8)·(|value| + scale)`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bounded {
+    /// The computed value.
+    pub value: f64,
+    /// The magnitude the rounding errors scale with (sums of absolute terms).
+    pub scale: f64,
+}
+
+impl Bounded {
+    /// The pad `SLACK·(|value| + scale)` that covers the evaluation error.
+    #[inline]
+    fn pad(self) -> f64 {
+        SLACK * (self.value.abs() + self.scale)
+    }
+
+    /// An `f32` at or above `x` (the lemma).
+    #[inline]
+    #[must_use]
+    pub fn upper(self) -> f32 {
+        round_up(self.value + self.pad())
+    }
+
+    /// An `f32` at or below `x` (the lemma).
+    #[inline]
+    #[must_use]
+    pub fn lower(self) -> f32 {
+        round_down(self.value - self.pad())
+    }
+
+    /// An `f64` at or below `x`: the pad is subtracted with one rounding, covered by the lemma.
+    #[inline]
+    #[must_use]
+    pub fn lower_f64(self) -> f64 {
+        self.value - self.pad()
+    }
+}
+
+/// The distance from `p` to the segment `[a, b]` (a point when `a = b`), bounded both ways.
+///
+/// Any `t ∈ [0, 1]` names the point `a + t(b − a)` of the exact segment, so the exact
+/// distance is at most `|(p − a) − t(b − a)|`. Each coordinate of that vector rounds four
+/// times (two differences, the product, the difference), within `γ(3)·(|p_j − a_j| +
+/// t·|b_j − a_j|)`; the norm (three squares, two sums, a root) adds `γ(3)` relative: the
+/// lemma's form with `scale = Σ_j |p_j − a_j| + t·Σ_j |b_j − a_j|`, so `upper()` is certified.
+/// The other way, `t` is the clamped projection, off the exact one by `γ(4)·|p − a|/|b − a|`;
+/// by Pythagoras the distance from `a + t(b − a)` exceeds the exact distance by at most
+/// `γ(4)·|p − a|`, within the same scale: `lower_f64()` never exceeds the exact distance.
+#[inline]
+pub(crate) fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> Bounded {
+    let ab = b - a;
+    let ap = p - a;
+    let length2 = ab.length_squared();
+    let t = if length2 > 0.0 {
+        (ap.dot(ab) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    Bounded {
+        value: (ap - ab * t).length(),
+        scale: ap.abs().element_sum() + t * ab.abs().element_sum(),
+    }
+}

@@ -1,0 +1,244 @@
+//! Capsules (swept spheres) and their fits.
+
+use super::ball::smallest_ball;
+use super::bound::{Bounded, segment_distance};
+use super::cloud::{self, exact};
+use super::eigen::principal_axes;
+use super::obb::{Obb3, tight_frames};
+use super::search::compass_search;
+use super::{Fit, FitError};
+use crate::Aabb3;
+use core::f64::consts::PI;
+use glam::{DVec3, Vec3, Vec3A};
+
+/// A capsule: the points `x` within `radius` of the segment `[a, b]`, exactly, on the `f32`
+/// fields (`dist(x, [a, b]) = min over real t ∈ [0, 1] of |x − a − t(b − a)|`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    /// One end of the axis segment.
+    pub a: Vec3A,
+    /// The other end.
+    pub b: Vec3A,
+    /// The radius.
+    pub radius: f32,
+}
+
+/// A capsule in `f64`, before rounding.
+#[derive(Clone, Copy, Debug)]
+struct Shape {
+    a: DVec3,
+    b: DVec3,
+    radius: f64,
+}
+
+impl Shape {
+    /// `π r² |b − a| + 4/3 π r³`.
+    fn volume(&self) -> f64 {
+        PI * self.radius * self.radius * (self.a.distance(self.b) + 4.0 / 3.0 * self.radius)
+    }
+}
+
+/// Golden-section steps of the tight fit's search over the radius.
+const RADIUS_STEPS: usize = 24;
+
+impl Capsule {
+    /// The capsule fitted to `points` with the given effort: [`Fit::Pca`] on the major
+    /// principal axis through the mean; [`Fit::Fast`] on the best axis of the fast box,
+    /// centered by the minimum enclosing circle of the points projected across it;
+    /// [`Fit::Tight`] on a direction optimised from the tight box's axes, with the radius
+    /// optimised too. All with the shortest segment (minimal caps), and the radius then
+    /// certified from every point.
+    ///
+    /// # Errors
+    /// [`FitError`] for no points or a non-finite point.
+    pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
+        cloud::validate(points)?;
+        let shape = match fit {
+            Fit::Pca => pca_shape(points),
+            Fit::Fast => fast_shape(points),
+            Fit::Tight => tight_shape(points),
+        };
+        Ok(Self::around(points, shape.a, shape.b))
+    }
+
+    /// The capsule on the segment `[a, b]` rounded to `f32`, its radius the largest
+    /// certified distance of a point to it ([`segment_distance`]).
+    fn around(points: &[Vec3], a: DVec3, b: DVec3) -> Self {
+        let (a, b) = (a.as_vec3a(), b.as_vec3a());
+        let (ad, bd) = (a.as_dvec3(), b.as_dvec3());
+        let radius = points
+            .iter()
+            .map(|&p| segment_distance(exact(p), ad, bd).upper())
+            .fold(0.0, f32::max);
+        Self { a, b, radius }
+    }
+
+    /// True when `p` may lie in the capsule: never false for a point of it, true only
+    /// within `2^-47·(dist + Σ_j |p_j − a_j| + Σ_j |b_j − a_j|)` of it. NaN gives false.
+    #[inline]
+    #[must_use]
+    pub fn contains_point(&self, p: Vec3A) -> bool {
+        let distance = segment_distance(p.as_dvec3(), self.a.as_dvec3(), self.b.as_dvec3());
+        distance.lower_f64() <= f64::from(self.radius)
+    }
+
+    /// The volume `π r² |b − a| + 4/3 π r³`.
+    #[inline]
+    #[must_use]
+    pub fn volume(&self) -> f32 {
+        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
+        let radius = f64::from(self.radius);
+        Shape { a, b, radius }.volume() as f32
+    }
+
+    /// An axis-aligned box, rounded outward, that contains the capsule:
+    /// `min(a, b) − r` and `max(a, b) + r`, one rounding each (the lemma's form).
+    #[must_use]
+    pub fn aabb(&self) -> Aabb3 {
+        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
+        let r = f64::from(self.radius);
+        let face = |p: DVec3, sign: f64, i: usize| Bounded {
+            value: p[i] + sign * r,
+            scale: p[i].abs() + r.abs(),
+        };
+        Aabb3::new(
+            Vec3A::from_array([0, 1, 2].map(|i| face(a.min(b), -1.0, i).lower())),
+            Vec3A::from_array([0, 1, 2].map(|i| face(a.max(b), 1.0, i).upper())),
+        )
+    }
+}
+
+/// The shortest segment on the line `origin + t·dir` (unit `dir`) whose capsule of radius
+/// `radius` holds `points` (minimal caps).
+///
+/// A point at height `s = (p − o)·d` and distance `ρ` from the line is in the capsule
+/// exactly when the segment meets `[s − w, s + w]`, `w = √(r² − ρ²)`: so the segment must
+/// reach up to `max(s − w)` and down to `min(s + w)`; when those cross, one point suffices
+/// (the capsule is a sphere). A point farther than `r` from the line counts with `w = 0`
+/// (the certified radius then grows to reach it).
+fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Shape {
+    let (mut top, mut bottom) = (f64::NEG_INFINITY, f64::INFINITY);
+    for &p in points {
+        let v = p - origin;
+        let s = v.dot(dir);
+        let w = (radius * radius - (v - dir * s).length_squared())
+            .max(0.0)
+            .sqrt();
+        top = top.max(s - w);
+        bottom = bottom.min(s + w);
+    }
+    let (t0, t1) = if top <= bottom {
+        let mid = 0.5 * (top + bottom);
+        (mid, mid)
+    } else {
+        (bottom, top)
+    };
+    Shape {
+        a: origin + dir * t0,
+        b: origin + dir * t1,
+        radius,
+    }
+}
+
+/// The line along `dir` through the center of the minimum enclosing circle of the points
+/// projected across it, and that circle's radius.
+fn circle_axis(points: &[DVec3], dir: DVec3) -> (DVec3, f64) {
+    let (e1, e2) = dir.any_orthonormal_pair();
+    let mut flat: Vec<[f64; 2]> = points.iter().map(|p| [p.dot(e1), p.dot(e2)]).collect();
+    cloud::shuffle(&mut flat);
+    let circle = smallest_ball(&flat);
+    (
+        e1 * circle.center[0] + e2 * circle.center[1],
+        circle.radius(),
+    )
+}
+
+/// The capsule along `dir` centered by the minimum enclosing circle, with minimal caps.
+fn circle_shape(points: &[DVec3], dir: DVec3) -> Shape {
+    let (origin, radius) = circle_axis(points, dir);
+    capped(points, origin, dir, radius)
+}
+
+/// The smallest of some capsules.
+fn smallest(shapes: impl IntoIterator<Item = Shape>) -> Shape {
+    shapes
+        .into_iter()
+        .min_by(|a, b| a.volume().total_cmp(&b.volume()))
+        .unwrap_or(Shape {
+            a: DVec3::ZERO,
+            b: DVec3::ZERO,
+            radius: 0.0,
+        })
+}
+
+/// The PCA baseline: the major principal axis of the distinct points through their mean,
+/// the radius the largest distance from that line.
+fn pca_shape(points: &[Vec3]) -> Shape {
+    let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
+    let unique_f32: Vec<Vec3> = distinct.iter().map(|p| p.as_vec3()).collect();
+    let mean = cloud::mean(&unique_f32);
+    let dir = principal_axes(cloud::covariance(&unique_f32, mean)).x_axis;
+    let radius = distinct
+        .iter()
+        .map(|&p| (p - mean).reject_from_normalized(dir).length())
+        .fold(0.0, f64::max);
+    capped(&distinct, mean, dir, radius)
+}
+
+/// The fast fit: the best of the fast box's three axes, each centered by a minimum
+/// enclosing circle.
+fn fast_shape(points: &[Vec3]) -> Shape {
+    let exact_points: Vec<DVec3> = points.iter().map(|&p| exact(p)).collect();
+    let frame =
+        Obb3::fit(points, Fit::Fast).map_or(glam::DMat3::IDENTITY, |b| b.rotation.as_dmat3());
+    smallest((0..3).filter_map(|k| {
+        let dir = frame.col(k).try_normalize()?;
+        Some(circle_shape(&exact_points, dir))
+    }))
+}
+
+/// The best radius for the axis along `dir`: a golden-section search of the volume over
+/// `r` from the enclosing circle's radius (the thinnest capsule) to the radius at which
+/// the segment shrinks to a point (a sphere on the axis).
+fn best_radius(points: &[DVec3], dir: DVec3) -> Shape {
+    let (origin, thinnest) = circle_axis(points, dir);
+    let sphere_like = capped(points, origin, dir, thinnest);
+    let middle = 0.5 * (sphere_like.a + sphere_like.b);
+    let widest = points
+        .iter()
+        .map(|p| p.distance(middle))
+        .fold(thinnest, f64::max);
+    let volume = |r: f64| capped(points, origin, dir, r).volume();
+    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut lo, mut hi) = (thinnest, widest);
+    for _ in 0..RADIUS_STEPS {
+        let (x1, x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        if volume(x1) <= volume(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    smallest([thinnest, 0.5 * (lo + hi), widest].map(|r| capped(points, origin, dir, r)))
+}
+
+/// The tight fit: from each axis of the tight box's candidate frames, a compass search
+/// over directions `normalize(d + θ0 e1 + θ1 e2)`, each direction with its best radius;
+/// never worse than the fast and PCA capsules.
+fn tight_shape(points: &[Vec3]) -> Shape {
+    let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
+    let mut tight = tight_frames(&distinct);
+    cloud::shuffle(&mut tight.support);
+    let support = &tight.support;
+    let searched = tight.frames.iter().take(2).flat_map(|frame| {
+        (0..3).map(move |k| {
+            let seed = frame.col(k);
+            let (e1, e2) = seed.any_orthonormal_pair();
+            let dir = |t: [f64; 2]| (seed + e1 * t[0] + e2 * t[1]).normalize();
+            let (t, _) = compass_search(|t| best_radius(support, dir(t)).volume(), 0.05, 1e-5, 200);
+            best_radius(support, dir(t))
+        })
+    });
+    let baseline = [fast_shape(points), pca_shape(points)];
+    smallest(searched.chain(baseline))
+}

@@ -1,0 +1,280 @@
+//! The convex hull of points in 3D: quickhull on exact orientation predicates.
+//!
+//! Points are the exact `f64` values of `f32` inputs, and every side-of-plane decision is
+//! Shewchuk's exact `orient3d` (the `robust` crate; exact here, since products of `f32`
+//! differences neither overflow nor underflow `f64`). A face sees a point only when the point
+//! lies strictly above its plane, so points on a face are dropped, coplanar faces may be
+//! adjacent, and the faces visible from a new point form a disk bounded by one simple cycle
+//! of horizon edges: each new face `(u, v, eye)` is glued to its neighbours through the
+//! directed-edge map alone. Exact predicates make the hull correct on planar, collinear and
+//! cospherical input, which is reported as [`Hull::Planar`], [`Hull::Segment`] or
+//! [`Hull::Point`]. The fits use the hull only to choose directions; containment never
+//! depends on it (every fit re-derives its extents from every input point).
+
+use glam::DVec3;
+use robust::{Coord, Coord3D, orient2d, orient3d};
+use std::collections::{HashMap, HashSet};
+
+/// The convex hull, by the dimension of the points' affine hull.
+#[derive(Clone, Debug)]
+pub(crate) enum Hull {
+    /// All points coincide.
+    Point,
+    /// All points lie on a line with this unit direction.
+    Segment(DVec3),
+    /// All points lie on a plane with this unit normal.
+    Planar(DVec3),
+    /// A solid hull: its vertices and its outward (counter-clockwise) triangles into them.
+    Solid {
+        /// The hull vertices.
+        vertices: Vec<DVec3>,
+        /// Triangles, as indices into `vertices`.
+        triangles: Vec<[usize; 3]>,
+    },
+}
+
+fn coord(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// Exact: `d` lies strictly above the plane of the counter-clockwise triangle `a, b, c`.
+fn above(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+    orient3d(coord(a), coord(b), coord(c), coord(d)) < 0.0
+}
+
+/// Exact: `a`, `b`, `c` are collinear (all three coordinate projections are).
+fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let project = |p: DVec3, i: usize, j: usize| Coord { x: p[i], y: p[j] };
+    [(0, 1), (1, 2), (2, 0)]
+        .iter()
+        .all(|&(i, j)| orient2d(project(a, i, j), project(b, i, j), project(c, i, j)) == 0.0)
+}
+
+/// The hull of distinct points.
+pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
+    let Some(&p0) = points.first() else {
+        return Hull::Point;
+    };
+    let farthest = |key: &dyn Fn(DVec3) -> f64| {
+        (0..points.len()).max_by(|&i, &j| key(points[i]).total_cmp(&key(points[j])))
+    };
+    let i1 = farthest(&|p| p.distance_squared(p0)).unwrap_or(0);
+    let p1 = points[i1];
+    if p1 == p0 {
+        return Hull::Point;
+    }
+    let axis = (p1 - p0).normalize();
+    let Some(i2) = (0..points.len()).find(|&i| !collinear(p0, p1, points[i])) else {
+        return Hull::Segment(axis);
+    };
+    let i2 = farthest(&|p| (p - p0).cross(axis).length_squared())
+        .filter(|&i| !collinear(p0, p1, points[i]))
+        .unwrap_or(i2);
+    let p2 = points[i2];
+    let normal = (p1 - p0).cross(p2 - p0).normalize();
+    let volume = |p: DVec3| orient3d(coord(p0), coord(p1), coord(p2), coord(p));
+    let Some(i3) = farthest(&|p| volume(p).abs()).filter(|&i| volume(points[i]) != 0.0) else {
+        return Hull::Planar(normal);
+    };
+    let mut hull = Quickhull::new(points, [0, i1, i2, i3]);
+    hull.run();
+    hull.into_hull()
+}
+
+/// The working state: faces with their outside sets, and the directed-edge map.
+struct Quickhull<'a> {
+    points: &'a [DVec3],
+    faces: Vec<[usize; 3]>,
+    alive: Vec<bool>,
+    outside: Vec<Vec<usize>>,
+    /// Directed edge `(u, v)` → the face that runs `u → v`.
+    edges: HashMap<(usize, usize), usize>,
+}
+
+impl<'a> Quickhull<'a> {
+    /// The tetrahedron on four affinely independent points, every other point assigned to
+    /// a face that sees it.
+    fn new(points: &'a [DVec3], [a, b, c, d]: [usize; 4]) -> Self {
+        let p = |i: usize| points[i];
+        // Make `d` lie below the base (a, b, c) so that all four faces turn outward.
+        let (b, c) = if above(p(a), p(b), p(c), p(d)) {
+            (c, b)
+        } else {
+            (b, c)
+        };
+        let mut hull = Self {
+            points,
+            faces: Vec::new(),
+            alive: Vec::new(),
+            outside: Vec::new(),
+            edges: HashMap::new(),
+        };
+        let new_faces: Vec<usize> = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]]
+            .into_iter()
+            .map(|f| hull.add_face(f))
+            .collect();
+        let rest = (0..points.len()).filter(|i| ![a, b, c, d].contains(i));
+        hull.assign(rest, &new_faces);
+        hull
+    }
+
+    fn add_face(&mut self, face: [usize; 3]) -> usize {
+        let id = self.faces.len();
+        for k in 0..3 {
+            self.edges.insert((face[k], face[(k + 1) % 3]), id);
+        }
+        self.faces.push(face);
+        self.alive.push(true);
+        self.outside.push(Vec::new());
+        id
+    }
+
+    fn sees(&self, face: usize, point: usize) -> bool {
+        let [a, b, c] = self.faces[face].map(|i| self.points[i]);
+        above(a, b, c, self.points[point])
+    }
+
+    /// Puts each point into the outside set of the first face that sees it; the others lie
+    /// inside the hull of the faces (Barber et al. 1996, Lemma 3.1) and are dropped.
+    fn assign(&mut self, points: impl Iterator<Item = usize>, faces: &[usize]) {
+        for i in points {
+            if let Some(&f) = faces.iter().find(|&&f| self.sees(f, i)) {
+                self.outside[f].push(i);
+            }
+        }
+    }
+
+    /// The point of the face's outside set farthest from its plane (`f64` is enough: any
+    /// point that the face sees is a valid choice).
+    fn eye(&self, face: usize) -> usize {
+        let [a, b, c] = self.faces[face].map(|i| self.points[i]);
+        let n = (b - a).cross(c - a);
+        let height = |i: usize| (self.points[i] - a).dot(n);
+        let set = &self.outside[face];
+        set.iter()
+            .copied()
+            .max_by(|&i, &j| height(i).total_cmp(&height(j)))
+            .unwrap_or(set[0])
+    }
+
+    /// Adds outside points until no face sees any.
+    fn run(&mut self) {
+        let mut stack: Vec<usize> = (0..self.faces.len()).collect();
+        while let Some(face) = stack.pop() {
+            if !self.alive[face] || self.outside[face].is_empty() {
+                continue;
+            }
+            let eye = self.eye(face);
+            let (visible, is_visible) = self.visible_from(face, eye);
+            let mut horizon = Vec::new();
+            let mut orphans = Vec::new();
+            for &f in &visible {
+                let tri = self.faces[f];
+                for k in 0..3 {
+                    let (u, v) = (tri[k], tri[(k + 1) % 3]);
+                    let across = self.edges.get(&(v, u)).copied();
+                    if across.is_some_and(|g| !is_visible.contains(&g)) {
+                        horizon.push((u, v));
+                    }
+                }
+                for k in 0..3 {
+                    self.edges.remove(&(tri[k], tri[(k + 1) % 3]));
+                }
+                self.alive[f] = false;
+                orphans.append(&mut self.outside[f]);
+            }
+            let new_faces: Vec<usize> = horizon
+                .into_iter()
+                .map(|(u, v)| self.add_face([u, v, eye]))
+                .collect();
+            self.assign(orphans.into_iter().filter(|&i| i != eye), &new_faces);
+            stack.extend(new_faces);
+        }
+    }
+
+    /// The faces that see `eye`: a connected disk, found by a walk from `start`; in walk
+    /// order (so the hull is the same on every run) and as a set.
+    fn visible_from(&self, start: usize, eye: usize) -> (Vec<usize>, HashSet<usize>) {
+        let (mut order, mut seen) = (vec![start], HashSet::from([start]));
+        let mut next = 0;
+        while let Some(&f) = order.get(next) {
+            next += 1;
+            let tri = self.faces[f];
+            for k in 0..3 {
+                if let Some(&g) = self.edges.get(&(tri[(k + 1) % 3], tri[k]))
+                    && !seen.contains(&g)
+                    && self.sees(g, eye)
+                {
+                    seen.insert(g);
+                    order.push(g);
+                }
+            }
+        }
+        (order, seen)
+    }
+
+    fn into_hull(self) -> Hull {
+        let mut index = HashMap::new();
+        let mut vertices = Vec::new();
+        let triangles = (0..self.faces.len())
+            .filter(|&f| self.alive[f])
+            .map(|f| {
+                self.faces[f].map(|i| {
+                    *index.entry(i).or_insert_with(|| {
+                        vertices.push(self.points[i]);
+                        vertices.len() - 1
+                    })
+                })
+            })
+            .collect();
+        Hull::Solid {
+            vertices,
+            triangles,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_a_cube_with_inner_and_face_points() {
+        let mut points: Vec<DVec3> = (0..8)
+            .map(|k| DVec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64))
+            .collect();
+        points.extend([
+            DVec3::splat(0.5),
+            DVec3::new(0.5, 0.5, 1.0),
+            DVec3::new(0.25, 0.0, 0.5),
+        ]);
+        let Hull::Solid {
+            vertices,
+            triangles,
+        } = convex_hull(&points)
+        else {
+            panic!("a cube is solid");
+        };
+        assert_eq!(vertices.len(), 8);
+        assert_eq!(triangles.len(), 12);
+        for t in &triangles {
+            let [a, b, c] = t.map(|i| vertices[i]);
+            assert!(
+                points.iter().all(|&p| !above(a, b, c, p)),
+                "every point below each face"
+            );
+        }
+        assert!(matches!(convex_hull(&points[..4]), Hull::Planar(n) if n.z.abs() == 1.0));
+        let line = [
+            DVec3::ZERO,
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-2.0, -4.0, -6.0),
+        ];
+        assert!(matches!(convex_hull(&line), Hull::Segment(_)));
+        assert!(matches!(convex_hull(&[DVec3::ONE]), Hull::Point));
+    }
+}

@@ -1,0 +1,430 @@
+//! Oriented bounding boxes and their fits.
+
+use super::bound::Bounded;
+use super::cloud::{self, DIRECTIONS, exact};
+
+/// DiTO-14's sample directions: the first 7 of [`DIRECTIONS`].
+const DITO_DIRECTIONS: [Vec3; 7] = [
+    DIRECTIONS[0],
+    DIRECTIONS[1],
+    DIRECTIONS[2],
+    DIRECTIONS[3],
+    DIRECTIONS[4],
+    DIRECTIONS[5],
+    DIRECTIONS[6],
+];
+use super::eigen::principal_axes;
+use super::hull::{Hull, convex_hull};
+use super::rect::min_area_rectangle;
+use super::search::compass_search;
+use super::{Fit, FitError};
+use crate::Aabb3;
+use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
+use std::collections::BTreeMap;
+
+/// An oriented box: the points `x` with `|(x − center)·axis_k| <= half_extents[k]` for each
+/// column `axis_k` of `rotation`.
+///
+/// The statement is exact on the `f32` fields as given: fitted rotations are orthonormal to
+/// within `f32` rounding, and the box is the parallelepiped those three slabs cut out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Obb3 {
+    /// The center.
+    pub center: Vec3A,
+    /// The half-extents along the box axes.
+    pub half_extents: Vec3A,
+    /// The box axes as columns (orthonormal, right-handed, for fitted boxes).
+    pub rotation: Mat3A,
+}
+
+/// Where a fitted box is centered.
+#[derive(Clone, Copy, Debug)]
+enum Center {
+    /// Halfway between the extreme projections on each axis (the smallest box).
+    Midrange,
+    /// At a given point, with symmetric half-extents (the PCA baseline's mean).
+    At(DVec3),
+}
+
+impl Obb3 {
+    /// The box fitted to `points` with the given effort.
+    ///
+    /// # Errors
+    /// [`FitError`] for no points or a non-finite point.
+    pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
+        let bounds = cloud::validate(points)?;
+        Ok(match fit {
+            Fit::Pca => fit_pca(points, &bounds),
+            Fit::Fast => fit_fast(points, &bounds),
+            Fit::Tight => fit_tight(points, &bounds),
+        })
+    }
+
+    /// The smallest box with the axes of `rotation` (rounded outward, midrange center)
+    /// holding `points`.
+    ///
+    /// # Errors
+    /// [`FitError`] for no points or a non-finite point.
+    pub fn from_axes(points: &[Vec3], rotation: Mat3A) -> Result<Self, FitError> {
+        let bounds = cloud::validate(points)?;
+        let [obb] = fit_axes(points, &bounds, [rotation], Center::Midrange);
+        Ok(obb)
+    }
+
+    /// True when `p` may lie in the box: never false for a point of the box, and true only
+    /// within `2^-47·Σ_j |p_j − c_j|` of it (an `f64` evaluation with the lemma of the fit
+    /// module's certified rounding). NaN gives false.
+    #[inline]
+    #[must_use]
+    pub fn contains_point(&self, p: Vec3A) -> bool {
+        // (p − c)·a_k: 3 subtractions, 3 products, 2 sums: γ(4)·Σ|p_j − c_j|·|a_kj|.
+        let d = p.as_dvec3() - self.center.as_dvec3();
+        (0..3).all(|k| {
+            let axis = self.rotation.col(k).as_dvec3();
+            let projection = Bounded {
+                value: d.dot(axis).abs(),
+                scale: d.abs().dot(axis.abs()),
+            };
+            projection.lower_f64() <= f64::from(self.half_extents[k])
+        })
+    }
+
+    /// The volume `8·h0·h1·h2` (the axes taken as orthonormal).
+    #[inline]
+    #[must_use]
+    pub fn volume(&self) -> f32 {
+        (8.0 * self.half_extents.as_dvec3().element_product()) as f32
+    }
+
+    /// An axis-aligned box, rounded outward, that contains the whole box.
+    ///
+    /// The box is `c + Σ_k s_k·b_k` with `|s_k| <= h_k`, where `b_k = (a_{k+1} × a_{k+2}) / det`
+    /// is the dual basis (`b_k·a_j = δ_kj`); so its AABB is `c ± e`, `e = Σ_k |b_k|·h_k`.
+    /// Error: each cross-product entry is one rounding (its products of `f32` are exact),
+    /// `det = a_0·(a_1 × a_2)` is off by `γ(4)·Δ` with `Δ = Σ_j |a_0j|·|(a_1 × a_2)_j|`, so with
+    /// `ρ = Δ/|det|` (1 for orthonormal axes) the computed `e` is within `(5 + 4ρ)·u·e` and
+    /// `c ∓ e` within `γ(8)·(|c ∓ e| + |c| + (1 + ρ)·e)`: the lemma's form. A singular
+    /// rotation bounds no box and gives the whole space; NaN gives [`Aabb3::NAN`]; a
+    /// negative half-extent, [`Aabb3::EMPTY`].
+    #[must_use]
+    pub fn aabb(&self) -> Aabb3 {
+        let h = self.half_extents.as_dvec3();
+        let c = self.center.as_dvec3();
+        if h.is_nan() || c.is_nan() || self.rotation.is_nan() {
+            return Aabb3::NAN;
+        }
+        if h.min_element() < 0.0 {
+            return Aabb3::EMPTY;
+        }
+        let a = [0, 1, 2].map(|k| self.rotation.col(k).as_dvec3());
+        let dual = [0, 1, 2].map(|k| a[(k + 1) % 3].cross(a[(k + 2) % 3]));
+        let det = a[0].dot(dual[0]).abs();
+        let spread = a[0].abs().dot(dual[0].abs()) / det;
+        let e: DVec3 = (0..3).map(|k| dual[k].abs() * (h[k] / det)).sum();
+        let unbounded = Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+        if !(e.is_finite() && c.is_finite() && spread.is_finite()) {
+            return unbounded;
+        }
+        let face = |i: usize, sign: f64| Bounded {
+            value: c[i] + sign * e[i],
+            scale: c[i].abs() + (1.0 + spread) * e[i],
+        };
+        Aabb3::new(
+            Vec3A::from_array([0, 1, 2].map(|i| face(i, -1.0).lower())),
+            Vec3A::from_array([0, 1, 2].map(|i| face(i, 1.0).upper())),
+        )
+    }
+}
+
+/// The `f32` rotation nearest to an orthonormal `f64` frame.
+fn to_f32(frame: DMat3) -> Mat3A {
+    Mat3A::from_cols(
+        frame.x_axis.as_vec3a(),
+        frame.y_axis.as_vec3a(),
+        frame.z_axis.as_vec3a(),
+    )
+}
+
+/// The boxes with the given axes holding `points`, in one pass, certified.
+///
+/// For an axis `a` (exact `f32`) and a point `p`, `p·a` in `f64` has exact products and two
+/// rounded sums: it is within `γ(2)·S` of the exact value, `S = Σ_j |a_j|·max(|min_j|, |max_j|)`
+/// over the bounding box. So every exact projection lies in `[lo − γ(2)S, hi + γ(2)S]` for
+/// the computed extremes `lo`, `hi`. With the center `c` rounded to `f32` and `c·a` within
+/// `γ(2)·C` (`C = Σ_j |c_j a_j|`), every `|(p − c)·a|` is at most
+/// `max(hi − c·a, c·a − lo) + γ(2)(S + C)`; one more rounding for that difference, and the
+/// lemma's `Bounded::upper` with `scale = S + C` is a certified half-extent.
+fn fit_axes<const N: usize>(
+    points: &[Vec3],
+    bounds: &Aabb3,
+    rotations: [Mat3A; N],
+    center: Center,
+) -> [Obb3; N] {
+    let axes = rotations.map(|r| r.as_dmat3().transpose());
+    let mut lo = [DVec3::INFINITY; N];
+    let mut hi = [DVec3::NEG_INFINITY; N];
+    for &p in points {
+        let p = exact(p);
+        for r in 0..N {
+            let q = axes[r] * p;
+            lo[r] = lo[r].min(q);
+            hi[r] = hi[r].max(q);
+        }
+    }
+    core::array::from_fn(|r| certified_box(rotations[r], lo[r], hi[r], bounds, center))
+}
+
+/// The certified box with axes `rotation` whose computed projection range is `[lo, hi]`
+/// (see [`fit_axes`]).
+fn certified_box(rotation: Mat3A, lo: DVec3, hi: DVec3, bounds: &Aabb3, center: Center) -> Obb3 {
+    let axes = [0, 1, 2].map(|k| rotation.col(k).as_dvec3());
+    let reach = bounds.min.abs().max(bounds.max.abs()).as_dvec3();
+    let c = match center {
+        Center::Midrange => (0..3).map(|k| axes[k] * (0.5 * (lo[k] + hi[k]))).sum(),
+        Center::At(c) => c,
+    };
+    let center = c.as_vec3a();
+    let cd = center.as_dvec3();
+    let half_extent = |k: usize| {
+        let cc = cd.dot(axes[k]);
+        Bounded {
+            value: (hi[k] - cc).max(cc - lo[k]),
+            scale: axes[k].abs().dot(reach + cd.abs()),
+        }
+        .upper()
+    };
+    Obb3 {
+        center,
+        half_extents: Vec3A::new(half_extent(0), half_extent(1), half_extent(2)),
+        rotation,
+    }
+}
+
+/// The box of least volume, then least surface (for flat sets, whose volumes tie at 0).
+fn smallest(boxes: impl IntoIterator<Item = Obb3>) -> Obb3 {
+    let key = |b: &Obb3| {
+        let h = b.half_extents.as_dvec3();
+        (h.element_product(), h.x * h.y + h.y * h.z + h.z * h.x)
+    };
+    boxes
+        .into_iter()
+        .min_by(|a, b| {
+            key(a)
+                .partial_cmp(&key(b))
+                .unwrap_or(core::cmp::Ordering::Equal)
+        })
+        .unwrap_or(Obb3 {
+            center: Vec3A::ZERO,
+            half_extents: Vec3A::ZERO,
+            rotation: Mat3A::IDENTITY,
+        })
+}
+
+/// The PCA baseline: eigenvectors of the covariance of the distinct points, centered on
+/// their mean, half-extents the largest `|projection|` about it.
+fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+    let distinct = cloud::unique(points);
+    let mean = cloud::mean(&distinct);
+    let axes = principal_axes(cloud::covariance(&distinct, mean));
+    let [obb] = fit_axes(&distinct, bounds, [to_f32(axes)], Center::At(mean));
+    obb
+}
+
+/// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
+/// points as given) and the best DiTO frame.
+fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+    let pca = principal_axes(cloud::covariance(points, cloud::mean(points)));
+    let extremal = cloud::extremal_points(points, &DITO_DIRECTIONS);
+    let dito = dito_frames(&extremal)
+        .into_iter()
+        .min_by(|a, b| volume_over(a, &extremal).total_cmp(&volume_over(b, &extremal)))
+        .unwrap_or(pca);
+    // The coordinate axes' projection range is the bounding box itself, exactly.
+    let aabb = certified_box(
+        Mat3A::IDENTITY,
+        bounds.min.as_dvec3(),
+        bounds.max.as_dvec3(),
+        bounds,
+        Center::Midrange,
+    );
+    let rotations = [pca, dito].map(to_f32);
+    smallest(
+        fit_axes(points, bounds, rotations, Center::Midrange)
+            .into_iter()
+            .chain([aabb]),
+    )
+}
+
+/// The extents `max − min` of the projections of `points` on the columns of `frame`.
+fn extents(frame: &DMat3, points: &[DVec3]) -> DVec3 {
+    let mut lo = DVec3::INFINITY;
+    let mut hi = DVec3::NEG_INFINITY;
+    for &p in points {
+        let q = frame.transpose() * p;
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    (hi - lo).max(DVec3::ZERO)
+}
+
+/// The volume of the box with axes `frame` around `points`.
+fn volume_over(frame: &DMat3, points: &[DVec3]) -> f64 {
+    extents(frame, points).element_product()
+}
+
+/// A right-handed orthonormal frame whose first axis is `axis` and second the part of
+/// `toward` orthogonal to it (any orthogonal direction when that part vanishes).
+fn frame_from(axis: DVec3, toward: DVec3) -> Option<DMat3> {
+    let u = axis.try_normalize()?;
+    let v = (toward - u * u.dot(toward))
+        .try_normalize()
+        .unwrap_or_else(|| u.any_orthonormal_vector());
+    Some(DMat3::from_cols(u, v, u.cross(v)))
+}
+
+/// DiTO's candidate frames (Larsson & Källberg 2011) from the extremal points, taken in
+/// pairs along each sample direction: the base triangle joins the farthest pair to the
+/// point farthest from their line; the points farthest above and below its plane add a
+/// tetrahedron on each side. Each triangle gives one frame per edge: the edge, the
+/// in-plane orthogonal, the normal.
+fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
+    let farthest = |key: &dyn Fn(DVec3) -> f64| {
+        extremal
+            .iter()
+            .copied()
+            .max_by(|&a, &b| key(a).total_cmp(&key(b)))
+            .unwrap_or(DVec3::ZERO)
+    };
+    let Some((p0, p1)) = extremal
+        .chunks_exact(2)
+        .map(|pair| (pair[0], pair[1]))
+        .max_by(|a, b| {
+            a.0.distance_squared(a.1)
+                .total_cmp(&b.0.distance_squared(b.1))
+        })
+    else {
+        return Vec::new();
+    };
+    let line = (p1 - p0).normalize_or_zero();
+    let p2 = farthest(&|p| (p - p0).cross(line).length_squared());
+    let normal = (p1 - p0).cross(p2 - p0);
+    let mut triangles = vec![[p0, p1, p2]];
+    for apex in [farthest(&|p| p.dot(normal)), farthest(&|p| -p.dot(normal))] {
+        triangles.extend([[p0, p1, apex], [p1, p2, apex], [p2, p0, apex]]);
+    }
+    triangles
+        .iter()
+        .flat_map(|t| {
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            (0..3).filter_map(move |k| frame_from(t[(k + 1) % 3] - t[k], n))
+        })
+        .collect()
+}
+
+/// The tight fit's candidate frames and the points that decide them (the hull vertices
+/// when the points span 3D, else all of them).
+pub(crate) struct TightFrames {
+    /// Candidate frames, best first.
+    pub frames: Vec<DMat3>,
+    /// The hull vertices (or every point for a flat set).
+    pub support: Vec<DVec3>,
+}
+
+/// How many face normals (largest faces first) get a min-area rectangle.
+const MAX_FACE_NORMALS: usize = 400;
+/// How many of the best face frames are refined by a local search over rotations.
+const REFINED: usize = 4;
+
+/// Candidate frames of the tight fit: for each hull face normal `n`, the minimum-area
+/// rectangle of the hull projected along `n`; the best few are refined by a compass search
+/// over rotations `R·exp(ω)`. Flat sets: the plane's normal and its min-area rectangle;
+/// collinear sets: the line; a single point: the identity.
+pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
+    let one = |frame: Option<DMat3>| TightFrames {
+        frames: vec![frame.unwrap_or(DMat3::IDENTITY)],
+        support: points.to_vec(),
+    };
+    match convex_hull(points) {
+        Hull::Point => one(None),
+        Hull::Segment(line) => one(frame_from(line, DVec3::ZERO)),
+        Hull::Planar(normal) => one(Some(rectangle_frame(normal, points))),
+        Hull::Solid {
+            vertices,
+            triangles,
+        } => {
+            let mut scored: Vec<(f64, DMat3)> = face_normals(&vertices, &triangles)
+                .into_iter()
+                .map(|n| rectangle_frame(n, &vertices))
+                .map(|f| (volume_over(&f, &vertices), f))
+                .collect();
+            scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let frames = scored
+                .iter()
+                .take(REFINED)
+                .map(|&(_, f)| refine(f, &vertices))
+                .collect();
+            TightFrames {
+                frames,
+                support: vertices,
+            }
+        }
+    }
+}
+
+/// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
+/// [`MAX_FACE_NORMALS`].
+fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
+    let mut by_direction: BTreeMap<[i64; 3], (f64, DVec3)> = BTreeMap::new();
+    for t in triangles {
+        let [a, b, c] = t.map(|i| vertices[i]);
+        let n = (b - a).cross(c - a);
+        let Some(unit) = n.try_normalize() else {
+            continue;
+        };
+        let key = (unit * f64::from(1u32 << 24))
+            .round()
+            .as_i64vec3()
+            .to_array();
+        let entry = by_direction.entry(key).or_insert((0.0, unit));
+        entry.0 += n.length();
+    }
+    let mut normals: Vec<(f64, DVec3)> = by_direction.into_values().collect();
+    normals.sort_by(|a, b| b.0.total_cmp(&a.0));
+    normals
+        .into_iter()
+        .take(MAX_FACE_NORMALS)
+        .map(|(_, n)| n)
+        .collect()
+}
+
+/// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
+/// points projected on the plane orthogonal to the unit `normal`.
+fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
+    let (e1, e2) = normal.any_orthonormal_pair();
+    let flat: Vec<DVec2> = points
+        .iter()
+        .map(|p| DVec2::new(p.dot(e1), p.dot(e2)))
+        .collect();
+    let (side, _) = min_area_rectangle(&flat);
+    let u = e1 * side.x + e2 * side.y;
+    DMat3::from_cols(u, normal.cross(u), normal)
+}
+
+/// A local minimum of the volume over rotations `frame·exp(ω)` near `frame`.
+fn refine(frame: DMat3, points: &[DVec3]) -> DMat3 {
+    let rotated =
+        |w: [f64; 3]| frame * DMat3::from_quat(DQuat::from_scaled_axis(DVec3::from_array(w)));
+    let (w, _) = compass_search(|w| volume_over(&rotated(w), points), 0.05, 1e-7, 3000);
+    rotated(w)
+}
+
+/// The tight fit: the smallest midrange box over the refined hull frames and the fast fit.
+fn fit_tight(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+    let distinct = cloud::unique(points);
+    let exact_points: Vec<DVec3> = distinct.iter().map(|&p| exact(p)).collect();
+    let tight = tight_frames(&exact_points).frames.into_iter().map(|f| {
+        let [obb] = fit_axes(&distinct, bounds, [to_f32(f)], Center::Midrange);
+        obb
+    });
+    smallest(tight.chain([fit_fast(points, bounds)]))
+}

@@ -1,0 +1,563 @@
+//! Fitting: every input point lies in every fitted volume, decided exactly.
+//!
+//! **How containment is checked.** Every finite `f32` is an integer multiple of `2^-149`,
+//! so `F(x) = x·2^149` is an integer ([`oracle::Exact`] gives it). Each containment
+//! statement of the docs is a polynomial inequality in the `f32` fields and coordinates, so
+//! it is decided exactly in big integers, with no rounding anywhere:
+//! - box: `|Σ_j (F(p_j) − F(c_j))·F(a_kj)| <= F(h_k)·2^149` for each axis `k`;
+//! - sphere: `Σ_j (F(p_j) − F(c_j))² <= F(r)²`;
+//! - capsule: with `v = F(p) − F(a)`, `w = F(b) − F(a)`: the exact closest point of the
+//!   segment is at `t = v·w / w·w`; `t <= 0`: `|v|² <= F(r)²`; `t >= 1`: `|F(p) − F(b)|² <=
+//!   F(r)²`; else `|v|²·|w|² − (v·w)² <= F(r)²·|w|²` (the squared distance times `|w|²`).
+//!
+//! Each check is shown to fail on a volume shrunk by one part in a million.
+#![allow(clippy::needless_range_loop)]
+
+mod meshes;
+mod oracle;
+
+use bvkit::{Aabb3, Capsule, Fit, FitError, Obb3, Sphere};
+use glam::{Mat3A, Quat, Vec3, Vec3A};
+use num_bigint::BigInt;
+use num_traits::Signed;
+use oracle::Exact;
+
+const MODES: [Fit; 3] = [Fit::Pca, Fit::Fast, Fit::Tight];
+
+/// `x·2^149`, exactly.
+fn fixed(x: f32) -> BigInt {
+    match Exact::of(x) {
+        Exact::Finite(v) => v >> 149usize,
+        _ => panic!("finite values only"),
+    }
+}
+
+fn fixed3(v: Vec3A) -> [BigInt; 3] {
+    v.to_array().map(fixed)
+}
+
+fn sub(a: &[BigInt; 3], b: &[BigInt; 3]) -> [BigInt; 3] {
+    core::array::from_fn(|i| &a[i] - &b[i])
+}
+
+fn dot(a: &[BigInt; 3], b: &[BigInt; 3]) -> BigInt {
+    (0..3).map(|i| &a[i] * &b[i]).sum()
+}
+
+fn cross(a: &[BigInt; 3], b: &[BigInt; 3]) -> [BigInt; 3] {
+    core::array::from_fn(|i| &a[(i + 1) % 3] * &b[(i + 2) % 3] - &a[(i + 2) % 3] * &b[(i + 1) % 3])
+}
+
+/// A fitted volume and its containment statement, decided exactly.
+trait Volume: Copy + std::fmt::Debug {
+    const NAME: &'static str;
+    fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError>;
+    fn holds_exactly(&self, p: Vec3A) -> bool;
+    fn contains_point(&self, p: Vec3A) -> bool;
+    fn volume(&self) -> f32;
+    fn aabb(&self) -> Aabb3;
+    /// True when the AABB contains every point of the volume, exactly.
+    fn aabb_holds_exactly(&self) -> bool;
+    /// The same volume shrunk by a factor `1 − s` about its center.
+    fn shrunk(&self, s: f32) -> Self;
+    /// The volume scaled by `s` about the origin.
+    fn scaled(&self, s: f32) -> Self;
+}
+
+/// `F(lo_i) <= F(c_i) − reach_i` and `F(hi_i) >= F(c_i) + reach_i` (all at scale `2^149`).
+fn aabb_reaches(aabb: &Aabb3, lo: &[BigInt; 3], hi: &[BigInt; 3], reach: &BigInt) -> bool {
+    let (min, max) = (fixed3(aabb.min), fixed3(aabb.max));
+    (0..3).all(|i| min[i] <= &lo[i] - reach && max[i] >= &hi[i] + reach)
+}
+
+impl Volume for Obb3 {
+    const NAME: &'static str = "obb";
+    fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
+        Obb3::fit(points, fit)
+    }
+    fn holds_exactly(&self, p: Vec3A) -> bool {
+        let d = sub(&fixed3(p), &fixed3(self.center));
+        (0..3).all(|k| {
+            let s = dot(&d, &fixed3(self.rotation.col(k)));
+            s.abs() <= fixed(self.half_extents[k]) << 149usize
+        })
+    }
+    fn contains_point(&self, p: Vec3A) -> bool {
+        Obb3::contains_point(self, p)
+    }
+    fn volume(&self) -> f32 {
+        Obb3::volume(self)
+    }
+    fn aabb(&self) -> Aabb3 {
+        Obb3::aabb(self)
+    }
+    /// The box is `c + Σ_k s_k b_k`, `|s_k| <= h_k`, with the dual basis `b_k = B_k / D`,
+    /// `B_k = a_{k+1} × a_{k+2}`, `D = a_0·B_0`; so face `i` needs
+    /// `(F(max_i) − F(c_i))·|D| >= Σ_k |B_ki|·F(h_k)·2^149` (and the same below).
+    fn aabb_holds_exactly(&self) -> bool {
+        let a = [0, 1, 2].map(|k| fixed3(self.rotation.col(k)));
+        let dual = [0, 1, 2].map(|k| cross(&a[(k + 1) % 3], &a[(k + 2) % 3]));
+        let det = dot(&a[0], &dual[0]).abs();
+        let h = fixed3(self.half_extents);
+        let c = fixed3(self.center);
+        let (min, max) = (fixed3(self.aabb().min), fixed3(self.aabb().max));
+        (0..3).all(|i| {
+            let reach: BigInt =
+                (0..3).map(|k| dual[k][i].abs() * &h[k]).sum::<BigInt>() << 149usize;
+            (&max[i] - &c[i]) * &det >= reach && (&c[i] - &min[i]) * &det >= reach
+        })
+    }
+    fn shrunk(&self, s: f32) -> Self {
+        Obb3 {
+            half_extents: self.half_extents * (1.0 - s),
+            ..*self
+        }
+    }
+    fn scaled(&self, s: f32) -> Self {
+        Obb3 {
+            center: self.center * s,
+            half_extents: self.half_extents * s,
+            ..*self
+        }
+    }
+}
+
+impl Volume for Sphere {
+    const NAME: &'static str = "sphere";
+    fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
+        Sphere::fit(points, fit)
+    }
+    fn holds_exactly(&self, p: Vec3A) -> bool {
+        let d = sub(&fixed3(p), &fixed3(self.center));
+        let r = fixed(self.radius);
+        dot(&d, &d) <= &r * &r
+    }
+    fn contains_point(&self, p: Vec3A) -> bool {
+        Sphere::contains_point(self, p)
+    }
+    fn volume(&self) -> f32 {
+        Sphere::volume(self)
+    }
+    fn aabb(&self) -> Aabb3 {
+        Sphere::aabb(self)
+    }
+    fn aabb_holds_exactly(&self) -> bool {
+        let c = fixed3(self.center);
+        aabb_reaches(&self.aabb(), &c, &c, &fixed(self.radius))
+    }
+    fn shrunk(&self, s: f32) -> Self {
+        Sphere {
+            radius: self.radius * (1.0 - s),
+            ..*self
+        }
+    }
+    fn scaled(&self, s: f32) -> Self {
+        Sphere {
+            center: self.center * s,
+            radius: self.radius * s,
+        }
+    }
+}
+
+impl Volume for Capsule {
+    const NAME: &'static str = "capsule";
+    fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
+        Capsule::fit(points, fit)
+    }
+    fn holds_exactly(&self, p: Vec3A) -> bool {
+        let (a, b, p) = (fixed3(self.a), fixed3(self.b), fixed3(p));
+        let r2 = fixed(self.radius).pow(2);
+        let (v, w) = (sub(&p, &a), sub(&b, &a));
+        let (vw, ww) = (dot(&v, &w), dot(&w, &w));
+        if vw <= BigInt::ZERO || ww == BigInt::ZERO {
+            dot(&v, &v) <= r2
+        } else if vw >= ww {
+            let u = sub(&p, &b);
+            dot(&u, &u) <= r2
+        } else {
+            dot(&v, &v) * &ww - &vw * &vw <= r2 * ww
+        }
+    }
+    fn contains_point(&self, p: Vec3A) -> bool {
+        Capsule::contains_point(self, p)
+    }
+    fn volume(&self) -> f32 {
+        Capsule::volume(self)
+    }
+    fn aabb(&self) -> Aabb3 {
+        Capsule::aabb(self)
+    }
+    fn aabb_holds_exactly(&self) -> bool {
+        let (a, b) = (fixed3(self.a), fixed3(self.b));
+        let lo = core::array::from_fn(|i| a[i].clone().min(b[i].clone()));
+        let hi = core::array::from_fn(|i| a[i].clone().max(b[i].clone()));
+        aabb_reaches(&self.aabb(), &lo, &hi, &fixed(self.radius))
+    }
+    fn shrunk(&self, s: f32) -> Self {
+        Capsule {
+            radius: self.radius * (1.0 - s),
+            ..*self
+        }
+    }
+    fn scaled(&self, s: f32) -> Self {
+        Capsule {
+            a: self.a * s,
+            b: self.b * s,
+            radius: self.radius * s,
+        }
+    }
+}
+
+/// Every mesh the containment tests run on, degenerate ones included.
+fn all_meshes() -> Vec<(&'static str, Vec<Vec3>)> {
+    let spot = meshes::spot();
+    let mut twice = spot.clone();
+    twice.extend(spot.iter().rev());
+    let mut meshes = meshes::real();
+    meshes.extend(meshes::procedural());
+    meshes.extend([
+        ("planar", meshes::planar(12)),
+        (
+            "planar tilted",
+            meshes::rotated(&meshes::planar(12), meshes::tilt()),
+        ),
+        ("collinear", meshes::collinear(15)),
+        (
+            "collinear tilted",
+            meshes::rotated(&meshes::collinear(15), meshes::tilt()),
+        ),
+        ("one point", vec![Vec3::new(1.5, -2.25, 1e-3)]),
+        ("two points", vec![Vec3::ZERO, Vec3::new(1e-30, 3.0, -7.0)]),
+        (
+            "far away",
+            meshes::rotated(&meshes::uv_sphere(1e-3, 5, 7), meshes::tilt())
+                .iter()
+                .map(|&p| p + Vec3::splat(1e4))
+                .collect(),
+        ),
+        ("spot twice", twice),
+    ]);
+    meshes
+}
+
+/// Every point of every mesh lies in the fitted volume (exactly), `contains_point` agrees,
+/// and the volume's AABB contains the exact volume.
+fn check_containment<V: Volume>() {
+    for (name, points) in all_meshes() {
+        for mode in MODES {
+            let fitted = V::fit(&points, mode).unwrap();
+            for &p in &points {
+                let p = Vec3A::from(p);
+                assert!(
+                    fitted.holds_exactly(p),
+                    "{} {mode:?} {name}: {p} outside {fitted:?}",
+                    V::NAME
+                );
+                assert!(
+                    fitted.contains_point(p),
+                    "{} {mode:?} {name}: contains_point({p})",
+                    V::NAME
+                );
+            }
+            assert!(
+                fitted.aabb_holds_exactly(),
+                "{} {mode:?} {name}: {:?}",
+                V::NAME,
+                fitted.aabb()
+            );
+            assert!(fitted.volume().is_finite());
+        }
+    }
+}
+
+#[test]
+fn every_point_lies_in_every_box() {
+    check_containment::<Obb3>();
+}
+
+#[test]
+fn every_point_lies_in_every_sphere() {
+    check_containment::<Sphere>();
+}
+
+#[test]
+fn every_point_lies_in_every_capsule() {
+    check_containment::<Capsule>();
+}
+
+/// The exact checks can fail: shrunk by one part in a million, each fitted volume loses a
+/// vertex (all fits are tight to far better than that).
+fn check_shrunk_fails<V: Volume>() {
+    for (name, points) in meshes::real().into_iter().chain(meshes::procedural()) {
+        for mode in MODES {
+            let smaller = V::fit(&points, mode).unwrap().shrunk(1e-6);
+            let lost = points.iter().any(|&p| !smaller.holds_exactly(p.into()));
+            assert!(lost, "{} {mode:?} {name}: not tight", V::NAME);
+        }
+    }
+}
+
+#[test]
+fn shrunk_volumes_lose_a_vertex() {
+    check_shrunk_fails::<Obb3>();
+    check_shrunk_fails::<Sphere>();
+    check_shrunk_fails::<Capsule>();
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let nan = vec![Vec3::ZERO, Vec3::ONE, Vec3::new(0.0, f32::NAN, 0.0)];
+    let inf = vec![Vec3::ZERO, Vec3::new(f32::NEG_INFINITY, 0.0, 0.0)];
+    for mode in MODES {
+        assert_eq!(Obb3::fit(&[], mode), Err(FitError::Empty));
+        assert_eq!(Sphere::fit(&[], mode), Err(FitError::Empty));
+        assert_eq!(Capsule::fit(&[], mode), Err(FitError::Empty));
+        assert!(matches!(
+            Obb3::fit(&nan, mode),
+            Err(FitError::NonFinite { index: 2, .. })
+        ));
+        assert!(matches!(
+            Sphere::fit(&inf, mode),
+            Err(FitError::NonFinite { index: 1, .. })
+        ));
+        assert!(matches!(
+            Capsule::fit(&inf, mode),
+            Err(FitError::NonFinite { index: 1, .. })
+        ));
+    }
+    let error: Box<dyn std::error::Error> = Box::new(Obb3::fit(&nan, Fit::Fast).unwrap_err());
+    assert!(error.to_string().contains("point 2 is not finite"));
+    assert!(FitError::Empty.to_string().contains("no points"));
+    assert_eq!(Fit::default(), Fit::Fast);
+}
+
+#[test]
+fn degenerate_sets_give_flat_volumes() {
+    let p = Vec3::new(1.5, -2.25, 1e-3);
+    for mode in MODES {
+        let s = Sphere::fit(&[p, p, p], mode).unwrap();
+        assert_eq!((s.center, s.radius), (Vec3A::from(p), 0.0), "{mode:?}");
+        let c = Capsule::fit(&[p], mode).unwrap();
+        assert_eq!((c.a, c.b, c.radius), (p.into(), p.into(), 0.0), "{mode:?}");
+        let b = Obb3::fit(&[p], mode).unwrap();
+        assert!(b.half_extents.max_element() <= 1e-12, "{mode:?} {b:?}");
+
+        // Collinear: the box and the capsule are thin needles along the line.
+        let line = meshes::rotated(&meshes::collinear(15), meshes::tilt());
+        let b = Obb3::fit(&line, mode).unwrap();
+        let mut h = b.half_extents.to_array();
+        h.sort_by(f32::total_cmp);
+        assert!(h[1] <= 1e-5 * h[2], "{mode:?} {b:?}");
+        let c = Capsule::fit(&line, mode).unwrap();
+        assert!(c.radius <= 1e-5 * c.a.distance(c.b), "{mode:?} {c:?}");
+    }
+    // Exactly planar: the tight box is the plane's minimum-area rectangle, of no thickness.
+    let plane = meshes::planar(12);
+    let tight = Obb3::fit(&plane, Fit::Tight).unwrap();
+    assert!(tight.half_extents.min_element() <= 1e-12, "{tight:?}");
+    let area = |b: &Obb3| {
+        let mut h = b.half_extents.to_array();
+        h.sort_by(f32::total_cmp);
+        4.0 * h[1] * h[2]
+    };
+    let swept = (0..3600)
+        .map(|i| {
+            let r = Mat3A::from_rotation_z(i as f32 * std::f32::consts::FRAC_PI_2 / 3600.0);
+            area(&Obb3::from_axes(&plane, r).unwrap())
+        })
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        area(&tight) <= swept * (1.0 + 1e-5),
+        "{} vs swept {swept}",
+        area(&tight)
+    );
+    assert!(area(&tight) >= swept * (1.0 - 1e-3));
+}
+
+#[test]
+fn duplicates_change_nothing_for_the_distinct_fits() {
+    let spot = meshes::spot();
+    let mut twice = spot.clone();
+    twice.extend(spot.iter().rev());
+    assert_eq!(Obb3::fit(&spot, Fit::Pca), Obb3::fit(&twice, Fit::Pca));
+    assert_eq!(Sphere::fit(&spot, Fit::Pca), Sphere::fit(&twice, Fit::Pca));
+    assert_eq!(
+        Sphere::fit(&spot, Fit::Tight),
+        Sphere::fit(&twice, Fit::Tight)
+    );
+    assert_eq!(
+        Capsule::fit(&spot, Fit::Pca),
+        Capsule::fit(&twice, Fit::Pca)
+    );
+}
+
+/// The fast box is never worse than the AABB nor the PCA axes with a midrange center; the
+/// tight box never worse than the fast one; the tight capsule never worse than the others.
+#[test]
+fn each_mode_is_at_least_as_good_as_its_baselines() {
+    for (name, points) in meshes::real().into_iter().chain(meshes::procedural()) {
+        let pca = Obb3::fit(&points, Fit::Pca).unwrap();
+        let fast = Obb3::fit(&points, Fit::Fast).unwrap().volume();
+        let aabb = Obb3::from_axes(&points, Mat3A::IDENTITY).unwrap().volume();
+        let midrange = Obb3::from_axes(&points, pca.rotation).unwrap().volume();
+        assert!(
+            fast <= aabb && fast <= midrange,
+            "{name}: {fast} vs {aabb}, {midrange}"
+        );
+        assert!(midrange <= pca.volume(), "{name}");
+        let tight = Obb3::fit(&points, Fit::Tight).unwrap().volume();
+        assert!(tight <= fast, "{name}: {tight} > {fast}");
+        let capsule = |mode| Capsule::fit(&points, mode).unwrap().volume();
+        let tight_capsule = capsule(Fit::Tight);
+        assert!(tight_capsule <= capsule(Fit::Fast) * (1.0 + 1e-6), "{name}");
+        assert!(tight_capsule <= capsule(Fit::Pca) * (1.0 + 1e-6), "{name}");
+        let sphere = |mode| Sphere::fit(&points, mode).unwrap().radius;
+        assert!(
+            sphere(Fit::Tight) <= sphere(Fit::Fast) * (1.0 + 1e-6),
+            "{name}"
+        );
+        assert!(
+            sphere(Fit::Fast) <= sphere(Fit::Tight) * 1.05f32.cbrt(),
+            "{name}"
+        );
+        assert!(
+            sphere(Fit::Tight) <= sphere(Fit::Pca) * (1.0 + 1e-6),
+            "{name}"
+        );
+    }
+}
+
+/// Shapes whose smallest volumes are known.
+#[test]
+fn known_answers() {
+    // A turned box surface: the tight box is the box, 4 × 2 × 1.
+    let q = meshes::tilt();
+    let turned = meshes::rotated(&meshes::box_surface(Vec3::new(2.0, 1.0, 0.5), 6), q);
+    let tight = Obb3::fit(&turned, Fit::Tight).unwrap();
+    assert!((tight.volume() / 8.0 - 1.0).abs() <= 1e-5, "{tight:?}");
+    // Cube corners ±1, turned: the smallest ball has radius √3.
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| {
+            q * Vec3::new(
+                [-1.0, 1.0][k & 1],
+                [-1.0, 1.0][k >> 1 & 1],
+                [-1.0, 1.0][k >> 2 & 1],
+            )
+        })
+        .collect();
+    let ball = Sphere::fit(&corners, Fit::Tight).unwrap();
+    assert!((ball.radius / 3f32.sqrt() - 1.0).abs() <= 1e-6, "{ball:?}");
+    // A UV sphere: its own radius, for the exact and the fast fits.
+    for mode in [Fit::Fast, Fit::Tight] {
+        let r = Sphere::fit(&meshes::uv_sphere(2.0, 16, 24), mode)
+            .unwrap()
+            .radius;
+        assert!((r / 2.0 - 1.0).abs() <= 1e-6, "{mode:?} {r}");
+    }
+    // A capsule-shaped cloud (a cylinder of radius 0.5 and half-height 2 with hemispheres):
+    // the tight capsule is that capsule.
+    let mut pill = meshes::cylinder(0.5, 2.0, 24, 4);
+    for p in meshes::uv_sphere(0.5, 12, 24) {
+        pill.push(p + Vec3::Z * 2.0f32.copysign(p.z));
+    }
+    let pill = meshes::rotated(&pill, q);
+    let c = Capsule::fit(&pill, Fit::Tight).unwrap();
+    let exact = std::f32::consts::PI * 0.25 * (4.0 + 4.0 / 3.0 * 0.5);
+    assert!(
+        (c.volume() / exact - 1.0).abs() <= 1e-3,
+        "{c:?}: {} vs {exact}",
+        c.volume()
+    );
+}
+
+/// Every fit of the points scaled by 1024 is the fit scaled by 1024, bit for bit.
+fn check_power_of_two_scaling<V: Volume + PartialEq>(points: &[Vec3]) {
+    let scaled = meshes::scaled(points, 1024.0);
+    for mode in MODES {
+        let (fit, fit_scaled) = (
+            V::fit(points, mode).unwrap(),
+            V::fit(&scaled, mode).unwrap(),
+        );
+        assert_eq!(fit.scaled(1024.0), fit_scaled, "{} {mode:?}", V::NAME);
+    }
+}
+
+/// Scaling by a power of two scales every fit exactly; other scales and turns change the
+/// volumes of the fits that do not depend on the coordinate axes by at most 1e-5 (the
+/// input's own rounding to `f32`).
+#[test]
+fn invariant_under_scale_and_rotation() {
+    let spot = meshes::spot();
+    check_power_of_two_scaling::<Obb3>(&spot);
+    check_power_of_two_scaling::<Sphere>(&spot);
+    check_power_of_two_scaling::<Capsule>(&spot);
+    let relative = |a: f32, b: f32| (a / b - 1.0).abs();
+    for scale in [1e-4f32, 0.37, 1e4] {
+        let s = meshes::scaled(&spot, scale);
+        let cube = scale.powi(3);
+        for mode in [Fit::Pca, Fit::Tight] {
+            let obb = Obb3::fit(&s, mode).unwrap().volume() / cube;
+            assert!(
+                relative(obb, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5,
+                "{mode:?} {scale}"
+            );
+        }
+        let r = Sphere::fit(&s, Fit::Tight).unwrap().radius / scale;
+        assert!(
+            relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5,
+            "{scale}"
+        );
+    }
+    for q in [
+        meshes::tilt(),
+        Quat::from_rotation_y(2.0),
+        Quat::from_rotation_x(-0.9),
+    ] {
+        let turned = meshes::rotated(&spot, q);
+        for mode in [Fit::Pca, Fit::Tight] {
+            let v = Obb3::fit(&turned, mode).unwrap().volume();
+            assert!(
+                relative(v, Obb3::fit(&spot, mode).unwrap().volume()) <= 1e-5,
+                "{mode:?} {q}"
+            );
+        }
+        let r = Sphere::fit(&turned, Fit::Tight).unwrap().radius;
+        assert!(
+            relative(r, Sphere::fit(&spot, Fit::Tight).unwrap().radius) <= 1e-5,
+            "{q}"
+        );
+    }
+}
+
+/// Hand-made boxes: a rotation off orthonormal, far from the origin; its AABB still
+/// contains the exact parallelepiped, and a singular rotation gives the whole space.
+#[test]
+fn aabb_of_any_box_contains_it() {
+    let skewed = Obb3 {
+        center: Vec3A::new(1e4, -3.0, 0.5),
+        half_extents: Vec3A::new(1.0, 2.0, 1e-3),
+        rotation: Mat3A::from_cols(
+            Vec3A::new(1.0, 0.001, 0.0),
+            Vec3A::new(0.0, 0.999, 0.002),
+            Vec3A::new(0.01, 0.0, 1.0),
+        ),
+    };
+    assert!(skewed.aabb_holds_exactly());
+    let flat = Obb3 {
+        rotation: Mat3A::from_cols(Vec3A::X, Vec3A::X, Vec3A::Z),
+        ..skewed
+    };
+    assert_eq!(
+        flat.aabb(),
+        Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY)
+    );
+    assert!(
+        !Obb3 {
+            center: Vec3A::NAN,
+            ..skewed
+        }
+        .aabb()
+        .is_valid()
+    );
+    assert!(!skewed.contains_point(Vec3A::NAN));
+}
