@@ -27,7 +27,7 @@ const MODES: [Fit; 3] = [Fit::Pca, Fit::Fast, Fit::Tight];
 /// `x·2^149`, exactly.
 fn fixed(x: f32) -> BigInt {
     match Exact::of(x) {
-        Exact::Finite(v) => v >> 149usize,
+        Exact::Finite(v) => v >> (oracle::SCALE - 149) as usize,
         _ => panic!("finite values only"),
     }
 }

@@ -16,7 +16,7 @@ use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
 
 /// The exponent of the fixed-point scale: exact values are `integer · 2^-SCALE`.
-const SCALE: i32 = 600;
+pub const SCALE: i32 = 600;
 
 /// An exact extended real: `±inf` or `integer · 2^-600`.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
