@@ -187,6 +187,18 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
             }
             return;
         }
+        if count == L::WIDTH && L::WIDTH % 8 == 0 {
+            for c in 0..L::WIDTH / 8 {
+                let fields = self[i / 8 + c].fields.as_mut();
+                for a in 0..N {
+                    for k in 0..8 {
+                        fields[a][k] = min.0[a].get(8 * c + k);
+                        fields[N + a][k] = max.0[a].get(8 * c + k);
+                    }
+                }
+            }
+            return;
+        }
         for k in 0..L::WIDTH {
             if k < count {
                 let (block, slot) = (&mut self[(i + k) / 8], (i + k) % 8);
@@ -236,6 +248,18 @@ fn gather_blocks<L: LaneArray, T: Fields>(
         let (fields, slot) = (blocks[i / 8].fields.as_ref(), i % 8);
         for n in 0..T::FIELDS {
             f[n] = L::load(&fields[n][slot..]);
+        }
+        return f;
+    }
+    if count == L::WIDTH && L::WIDTH % 8 == 0 {
+        // Wider lanes than a block (16 for AVX-512): whole blocks, eight lanes at a time.
+        for c in 0..L::WIDTH / 8 {
+            let fields = blocks[i / 8 + c].fields.as_ref();
+            for n in 0..T::FIELDS {
+                for k in 0..8 {
+                    f[n].set(8 * c + k, fields[n][k]);
+                }
+            }
         }
         return f;
     }
