@@ -189,11 +189,11 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
         }
         if count == L::WIDTH && L::WIDTH % 8 == 0 {
             for c in 0..L::WIDTH / 8 {
-                let fields = self[i / 8 + c].fields.as_mut();
+                let (lows, highs) = self[i / 8 + c].fields.as_mut().split_at_mut(N);
                 for a in 0..N {
-                    for k in 0..8 {
-                        fields[a][k] = min.0[a].get(8 * c + k);
-                        fields[N + a][k] = max.0[a].get(8 * c + k);
+                    for (k, (lo, hi)) in lows[a].iter_mut().zip(&mut highs[a]).enumerate() {
+                        *lo = min.0[a].get(8 * c + k);
+                        *hi = max.0[a].get(8 * c + k);
                     }
                 }
             }
@@ -256,8 +256,8 @@ fn gather_blocks<L: LaneArray, T: Fields>(
         for c in 0..L::WIDTH / 8 {
             let fields = blocks[i / 8 + c].fields.as_ref();
             for n in 0..T::FIELDS {
-                for k in 0..8 {
-                    f[n].set(8 * c + k, fields[n][k]);
+                for (k, &x) in fields[n].iter().enumerate() {
+                    f[n].set(8 * c + k, x);
                 }
             }
         }

@@ -5,7 +5,7 @@
 //! per face), then rotated by `R(q)`, computed in lanes straight from the quaternion, and
 //! translated. No `Affine3A` is built.
 
-use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
+use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
 use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform3, vector_at};
 use crate::extended::ExtendedMap;
@@ -220,12 +220,31 @@ fn quat_lanes<L: Lane, const SCALED: bool>(
     }
 }
 
-/// The same on glam's `Vec3A`, `R(q)` computed once in `f32`.
+/// The same on glam's `Vec3A`: `R(q)` in SIMD lanes, with the products and sums of
+/// [`kernel::rotation`] in the same order (so the same bits, without a round trip of nine
+/// scalars through memory).
 #[inline(always)]
 fn quat_simd<const SCALED: bool>(q: Quat, scale: Vec3A, t: Vec3A) -> QuatLanes<Vec3A, SCALED> {
-    let (cols, rho) = kernel::rotation(q.to_array());
+    let (v, w) = (Vec3A::new(q.x, q.y, q.z), q.w);
+    let v2 = v + v;
+    let sq = v * v2; // (xx, yy, zz)
+    let p = v.yxx() * v2.zzy(); // (yz, xz, xy)
+    let wv = Vec3A::splat(w) * v2; // (wx, wy, wz)
+    let diagonal = Vec3A::ONE - (sq.yxx() + sq.zzy()); // 1 − (yy + zz), …
+    let (a, b) = (p + wv, p - wv); // (yz + wx, xz + wy, xy + wz), (yz − wx, xz − wy, xy − wz)
+    let pick = |first: Vec3A, second: Vec3A, third: Vec3A| {
+        let keep_first = BVec3A::new(true, false, false);
+        let keep_second = BVec3A::new(false, true, false);
+        Vec3A::select(keep_first, first, Vec3A::select(keep_second, second, third))
+    };
+    let cols = [
+        pick(diagonal, a.zzz(), b.yyy()),
+        pick(b.zzz(), diagonal, a.xxx()),
+        pick(a.yyy(), b.xxx(), diagonal),
+    ];
+    let rho = 1.0 + ((sq.x + sq.y) + (sq.z + w * (w + w)));
     QuatLanes {
-        cols: cols.map(Vec3A::from_array),
+        cols,
         rho: Vec3A::splat(rho),
         scale,
         t,
