@@ -4,7 +4,6 @@
 mod common;
 
 use std::hint::black_box;
-use std::time::Duration;
 
 use bvkit::{Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rounding};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -34,24 +33,18 @@ fn bench(c: &mut Criterion) {
         let (bs, xs) = (AabbSoa::from_slice(&boxes), Affine3Soa::from_slice(&xfs));
         let (pb, pp) = parry_scene(&boxes, &poses);
         let mut o8 = vec![Aabb3x8::default(); b8.len()];
+        let (braw, xraw) = (raw(&b8, |b| b.fields), raw(&x8, |x| x.fields));
+        let mut oraw = braw.clone();
         let mut os = AabbSoa::filled(n, Aabb3::EMPTY);
         let mut oa = vec![Aabb3::EMPTY; n];
         let mut op = pb.clone();
 
         let mut g = c.benchmark_group(format!("batch/{size}"));
         g.throughput(Throughput::Elements(n as u64));
-        if n >= 1 << 20 {
-            g.sample_size(10)
-                .measurement_time(Duration::from_secs(3))
-                .warm_up_time(Duration::from_millis(500));
-        } else {
-            g.sample_size(30)
-                .measurement_time(Duration::from_millis(1500))
-                .warm_up_time(Duration::from_millis(300));
-        }
+        configure(&mut g, n);
 
         g.bench_function("roofline/aosoa", |b| {
-            b.iter(|| roofline_aosoa(black_box(&b8), black_box(&x8), &mut o8))
+            b.iter(|| roofline_blocks(black_box(&braw), black_box(&xraw), &mut oraw))
         });
         g.bench_function("roofline/soa", |b| {
             b.iter(|| roofline_soa(black_box(&bs), black_box(&xs), &mut os))

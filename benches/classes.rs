@@ -9,7 +9,6 @@
 mod common;
 
 use std::hint::black_box;
-use std::time::Duration;
 
 use bvkit::{Aabb3, Aabb3x8, Batch, Block8, Method, Rounding, Transform3};
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
@@ -29,13 +28,10 @@ fn class<T: Transform3, const F: usize>(
     name: &str,
     boxes: &[Aabb3],
     xfs: &[T],
-    raw: impl Fn(&Block8<T>) -> [[f32; 8]; F],
+    fields: impl Fn(&Block8<T>) -> [[f32; 8]; F],
 ) {
     let (b8, x8) = (Aabb3x8::pack(boxes), Block8::pack(xfs));
-    let (braw, xraw): (Vec<_>, Vec<_>) = (
-        b8.iter().map(|b| b.fields).collect(),
-        x8.iter().map(raw).collect(),
-    );
+    let (braw, xraw) = (common::raw(&b8, |b| b.fields), common::raw(&x8, fields));
     let mut oraw = braw.clone();
     let mut o8 = vec![Aabb3x8::default(); b8.len()];
     let mut out = vec![Aabb3::EMPTY; boxes.len()];
@@ -71,15 +67,7 @@ fn bench(c: &mut Criterion) {
 
         let mut g = c.benchmark_group(format!("classes/{size}"));
         g.throughput(Throughput::Elements(n as u64));
-        if n >= 1 << 20 {
-            g.sample_size(10)
-                .measurement_time(Duration::from_secs(3))
-                .warm_up_time(Duration::from_millis(500));
-        } else {
-            g.sample_size(30)
-                .measurement_time(Duration::from_millis(1500))
-                .warm_up_time(Duration::from_millis(300));
-        }
+        configure(&mut g, n);
         g.bench_function("peer/parry3d-transform_by", |b| {
             b.iter(|| parry_transform_by(black_box(&pb), black_box(&pp), &mut op))
         });

@@ -233,11 +233,16 @@ fn measure_3d(backends: &[Backend]) -> Vec<Row> {
         t,
         peer_accuracy(common::glam_abs_matrix),
     ));
+    let (braw, xraw) = (
+        common::raw(&b8, |b| b.fields),
+        common::raw(&x8, |x| x.fields),
+    );
+    let mut oraw = braw.clone();
     let t = times(|n| {
-        common::roofline_aosoa(
-            black_box(&b8[..n / 8]),
-            black_box(&x8[..n / 8]),
-            &mut o8[..n / 8],
+        common::roofline_blocks(
+            black_box(&braw[..n / 8]),
+            black_box(&xraw[..n / 8]),
+            &mut oraw[..n / 8],
         )
     });
     rows.push(row(
@@ -646,8 +651,7 @@ fn measure_class<T: Transform3, P: Exactly<3>, const F: usize>(
     progress(class);
     let mut rows = Vec::new();
     let (b8, x8) = (Aabb3x8::pack(boxes), Block8::pack(xfs));
-    let braw: Vec<[[f32; 8]; 6]> = b8.iter().map(|b| b.fields).collect();
-    let xraw: Vec<[[f32; 8]; F]> = x8.iter().map(raw).collect();
+    let (braw, xraw) = (common::raw(&b8, |b| b.fields), common::raw(&x8, raw));
     let (mut oraw, mut o8) = (braw.clone(), vec![Aabb3x8::default(); b8.len()]);
     let mut out = vec![Aabb3::EMPTY; boxes.len()];
     let (sb, sx): (Vec<Aabb3>, Vec<T>) = sample.iter().map(|(_, p)| inputs(p)).unzip();

@@ -1,7 +1,7 @@
 //! Inputs, peers and memory rooflines shared by the benches and the trade report.
 #![allow(dead_code)]
 
-use bvkit::{Aabb3, Aabb3x8, Affine3x8};
+use bvkit::Aabb3;
 use glam::{Affine3A, Quat, Vec3, Vec3A};
 
 /// A small deterministic generator (xorshift64*), so inputs need no RNG crate.
@@ -105,21 +105,6 @@ pub fn parry_scene(
     )
 }
 
-/// Memory roofline for AoSoA: reads every byte of the boxes and transforms and writes every
-/// byte of the output, in the same layout, with one addition per input float.
-pub fn roofline_aosoa(boxes: &[Aabb3x8], xfs: &[Affine3x8], out: &mut [Aabb3x8]) {
-    for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
-        for a in 0..3 {
-            for k in 0..8 {
-                let c = &x.fields;
-                let m = c[a][k] + c[3 + a][k] + c[6 + a][k] + c[9 + a][k];
-                o.fields[a][k] = b.fields[a][k] + m;
-                o.fields[3 + a][k] = b.fields[3 + a][k] + m;
-            }
-        }
-    }
-}
-
 /// Memory roofline for SoA columns (6 box columns, 12 transform columns, 6 outputs).
 pub fn roofline_soa(boxes: &bvkit::AabbSoa, xfs: &bvkit::Affine3Soa, out: &mut bvkit::AabbSoa) {
     for a in 0..3 {
@@ -219,5 +204,30 @@ pub fn roofline_blocks<const F: usize>(
                 o[n][k] = b[n][k] + m[k];
             }
         }
+    }
+}
+
+/// The fields of AoSoA blocks as plain arrays, for [`roofline_blocks`].
+pub fn raw<T, const F: usize>(
+    blocks: &[T],
+    fields: impl Fn(&T) -> [[f32; 8]; F],
+) -> Vec<[[f32; 8]; F]> {
+    blocks.iter().map(fields).collect()
+}
+
+/// Criterion settings for a group of `n` boxes: fewer, longer samples at DRAM sizes.
+pub fn configure(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    n: usize,
+) {
+    use std::time::Duration;
+    if n >= 1 << 20 {
+        g.sample_size(10)
+            .measurement_time(Duration::from_secs(3))
+            .warm_up_time(Duration::from_millis(500));
+    } else {
+        g.sample_size(30)
+            .measurement_time(Duration::from_millis(1500))
+            .warm_up_time(Duration::from_millis(300));
     }
 }
