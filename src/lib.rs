@@ -63,7 +63,7 @@
 #![allow(private_interfaces, private_bounds)]
 
 mod aabb;
-mod batch;
+pub mod batch;
 mod block;
 mod error;
 mod extended;
