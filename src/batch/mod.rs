@@ -7,14 +7,15 @@
 //! | layout | boxes read | boxes written | transforms read |
 //! |---|---|---|---|
 //! | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
-//! | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T, F>]` (`&[Rigid3x8]`, …) |
+//! | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T>]` (`&[Rigid3x8]`, …) |
 //! | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
 //! | shared | | | `&T`: one transform for the whole batch |
 //!
 //! `T` is any transform class ([`crate::transform`]); 2D boxes (`Aabb2`) work the same
 //! way. Every combination runs the same lane-generic kernels as the single-box path and
 //! keeps the same contract; lengths are checked before anything is written, and any
-//! length is accepted (the last partial block runs with masked lanes).
+//! length is accepted (the last partial block runs one box at a time, in one lane of the
+//! same arithmetic).
 
 mod aos;
 mod aosoa;
@@ -196,9 +197,8 @@ impl<B, X, O> Run<B, X, O> {
         let map = self.xf.load::<L>(i, count);
         let (min, max, stands) = block::transform(&map, lo, hi, method, outward);
         self.out.store(i, count, min, max);
-        // Lanes past `count` hold a zero box through a zero map: they stand. The rare
-        // others are recomputed from the source data; nothing here takes `&mut self` out
-        // of line, so the layout descriptors stay in registers.
+        // The rare lanes that do not stand are recomputed from the source data; nothing
+        // here takes `&mut self` out of line, so the layout descriptors stay in registers.
         if stands.any_nonzero() {
             for k in 0..count {
                 if stands.get(k) != 0.0 {
