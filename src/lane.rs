@@ -19,9 +19,10 @@ pub trait Lane:
 {
     /// Every lane set to `x`.
     fn splat(x: f32) -> Self;
-    /// Lane-wise minimum (NaN handling unspecified: the callers never depend on it).
+    /// Lane-wise minimum as `minps` computes it: `self < other ? self : other`, so equal
+    /// zeros and NaN operands give `other` (the callers never depend on NaN handling).
     fn min(self, other: Self) -> Self;
-    /// Lane-wise maximum (NaN handling unspecified: the callers never depend on it).
+    /// Lane-wise maximum as `maxps` computes it: `self > other ? self : other`.
     fn max(self, other: Self) -> Self;
     /// Lane-wise absolute value (exact: clears the sign bit).
     fn abs(self) -> Self;
@@ -44,11 +45,13 @@ impl Lane for f32 {
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
-        f32::min(self, other)
+        // Compare-select, as `minps` does: equal operands (`±0`) give `other`, so every
+        // lane type picks the same zero.
+        if self < other { self } else { other }
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        f32::max(self, other)
+        if self > other { self } else { other }
     }
     #[inline(always)]
     fn abs(self) -> Self {

@@ -62,15 +62,17 @@ impl Aabb3 {
             return self.transformed_scalar(xf, method, rounding);
         }
         let outward = rounding == Rounding::Outward;
-        let (min, max) = xf.simd().transform(self.min, self.max, method, outward);
-        // One mask, one branch: non-empty, NaN-free input, and a finite result (`x·0` is
-        // 0 for finite `x`, NaN for `±inf` and NaN).
-        let finite = (min * 0.0 + max * 0.0).cmpeq(Vec3A::ZERO);
-        if (self.min.cmple(self.max) & finite).all() {
-            Aabb3 { min, max }
-        } else {
-            self.transformed_extended(xf, rounding)
+        let (mut min, mut max) = xf.simd().transform(self.min, self.max, method, outward);
+        // One mask, one branch. The input is non-empty and NaN-free (`min <= max`), and
+        // the result finite: every kernel gives `min <= max` for such input, so
+        // `max − min <= f32::MAX` fails exactly when a face is infinite or NaN (or, rarely,
+        // when the finite box is wider than `f32::MAX`, which the extended path handles).
+        let ok = (max - min).cmple(Vec3A::splat(f32::MAX)) & self.min.cmple(self.max);
+        if !ok.all() {
+            // Assigned rather than returned, so the fast path keeps its faces in registers.
+            Aabb3 { min, max } = self.transformed_extended(xf, rounding);
         }
+        Aabb3 { min, max }
     }
 
     /// [`Aabb3::transformed`] computed in plain `f32`, one component at a time: the
