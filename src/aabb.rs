@@ -215,6 +215,24 @@ impl Fields for Aabb2 {
 }
 
 /// A box type of `N` dimensions: its fields are `min` then `max`.
-pub(crate) trait Boxes<const N: usize>: Fields {}
-impl Boxes<3> for Aabb3 {}
+pub(crate) trait Boxes<const N: usize>: Fields {
+    /// The slice as 3D boxes, when it is one (for the paired AoS path).
+    fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
+        let _ = items;
+        None
+    }
+    /// The mutable slice as 3D boxes, when it is one.
+    fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
+        let _ = items;
+        None
+    }
+}
+impl Boxes<3> for Aabb3 {
+    fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
+        Some(items)
+    }
+    fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
+        Some(items)
+    }
+}
 impl Boxes<2> for Aabb2 {}

@@ -6,7 +6,8 @@
 //! width, has no mask at all.
 
 use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use super::{BatchError, box_lanes, zero_fields};
+use super::{BatchError, Maps, box_lanes, zero_fields};
+use crate::aabb::Aabb3;
 use crate::aabb::Boxes;
 use crate::lane::Vector;
 use crate::simd::LaneArray;
@@ -39,6 +40,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
         let (lo, hi) = box_lanes::<f32, N>(&self[i].to_fields());
         (lo.0, hi.0)
     }
+    fn aabb3s(&self) -> Option<&[Aabb3]> {
+        B::aabb3s(self)
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
@@ -70,6 +74,9 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
         v[N..2 * N].copy_from_slice(&max);
         self[i] = B::from_fields(&v);
     }
+    fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
+        B::aabb3s_mut(self)
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
@@ -83,6 +90,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     }
     fn get(&self, i: usize) -> T {
         self[i]
+    }
+    fn maps(&self) -> Option<Maps<'_, T>> {
+        Some(Maps::Each(self))
     }
 }
 
@@ -104,12 +114,12 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
     fn get(&self, _: usize) -> T {
         **self
     }
+    fn maps(&self) -> Option<Maps<'_, T>> {
+        Some(Maps::Shared(self))
+    }
 }
 
-impl<'a, const N: usize, E> ReadBoxes<N> for &'a Vec<E>
-where
-    &'a [E]: ReadBoxes<N>,
-{
+impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
     fn len(&self) -> Result<usize, BatchError> {
         ReadBoxes::len(&self.as_slice())
     }
@@ -120,12 +130,12 @@ where
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.as_slice(), i)
     }
+    fn aabb3s(&self) -> Option<&[Aabb3]> {
+        E::aabb3s(self.as_slice())
+    }
 }
 
-impl<const N: usize, E> WriteBoxes<N> for &mut Vec<E>
-where
-    for<'b> &'b mut [E]: WriteBoxes<N>,
-{
+impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.as_mut_slice())
     }
@@ -142,13 +152,13 @@ where
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);
     }
+    fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
+        E::aabb3s_mut(self.as_mut_slice())
+    }
 }
 
-impl<'a, const N: usize, E> ReadMaps<N> for &'a Vec<E>
-where
-    &'a [E]: ReadMaps<N>,
-{
-    type Class = <&'a [E] as ReadMaps<N>>::Class;
+impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
+    type Class = E;
     fn len(&self) -> Option<usize> {
         ReadMaps::len(&self.as_slice())
     }
@@ -158,5 +168,8 @@ where
     }
     fn get(&self, i: usize) -> Self::Class {
         ReadMaps::get(&self.as_slice(), i)
+    }
+    fn maps(&self) -> Option<Maps<'_, Self::Class>> {
+        Some(Maps::Each(self.as_slice()))
     }
 }

@@ -233,6 +233,52 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     }
 }
 
+impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
+    fn len(&self) -> Result<usize, BatchError> {
+        ReadBoxes::len(&self.as_slice())
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
+        ReadBoxes::load(&self.as_slice(), i, count)
+    }
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
+        ReadBoxes::get(&self.as_slice(), i)
+    }
+}
+
+impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
+    fn len(&mut self) -> Result<usize, BatchError> {
+        WriteBoxes::len(&mut self.as_mut_slice())
+    }
+    #[inline(always)]
+    fn store<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
+    ) {
+        self.as_mut_slice().store(i, count, min, max);
+    }
+    fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
+        self.as_mut_slice().set(i, min, max);
+    }
+}
+
+impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
+    type Class = T;
+    fn len(&self) -> Option<usize> {
+        ReadMaps::len(&self.as_slice())
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
+        ReadMaps::load(&self.as_slice(), i, count)
+    }
+    fn get(&self, i: usize) -> T {
+        ReadMaps::get(&self.as_slice(), i)
+    }
+}
+
 /// Lanes `i..i + count` of every field of the blocks. When they fill a whole lane block
 /// inside one AoSoA block (`i` a multiple of the lane width, which divides 8) each field
 /// is one vector load; otherwise (the tail, or 16 lanes spanning two blocks) lanes go one

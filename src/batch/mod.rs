@@ -18,6 +18,7 @@
 //! same arithmetic).
 
 mod aos;
+mod aos3;
 mod aosoa;
 mod soa;
 
@@ -40,6 +41,7 @@ pub use soa::{
 };
 
 use crate::aabb::Aabb3;
+pub(crate) use aos3::{Aos3, Maps};
 
 /// Why a batch was refused. Nothing was written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,6 +103,10 @@ pub(crate) mod sealed {
         fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
         /// Box `i` as `(min, max)`, for the extended path.
         fn get(&self, i: usize) -> ([f32; N], [f32; N]);
+        /// The boxes as an AoS slice of [`Aabb3`], when they are one.
+        fn aabb3s(&self) -> Option<&[Aabb3]> {
+            None
+        }
     }
 
     /// Boxes to write.
@@ -118,6 +124,10 @@ pub(crate) mod sealed {
         );
         /// Writes box `i`.
         fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
+        /// The boxes as an AoS slice of [`Aabb3`], when they are one.
+        fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
+            None
+        }
     }
 
     /// Transforms to read.
@@ -131,6 +141,10 @@ pub(crate) mod sealed {
         -> <Self::Class as Class<N>>::Lanes<L>;
         /// Transform `i`, for the extended path.
         fn get(&self, i: usize) -> Self::Class;
+        /// The transforms as an AoS slice or one shared transform, when they are.
+        fn maps(&self) -> Option<Maps<'_, Self::Class>> {
+            None
+        }
     }
 }
 
@@ -251,6 +265,7 @@ pub struct Batch {
     /// The rounding guarantee.
     pub rounding: Rounding,
     backend: Backend,
+    deterministic: bool,
 }
 
 impl Batch {
@@ -261,7 +276,27 @@ impl Batch {
             method,
             rounding,
             backend: Backend::detect(),
+            deterministic: false,
         }
+    }
+
+    /// The same batch in deterministic mode, for lockstep networking and replays: no
+    /// multiply-add is fused, and the AoS path runs in lanes like every other layout, so
+    /// that every backend, every layout and the scalar reference give the same bits
+    /// (on any x86-64 CPU, for the same build). It costs the fused backends a few percent
+    /// in cache; the default stays the fastest.
+    #[must_use]
+    pub fn deterministic(self) -> Self {
+        Self {
+            deterministic: true,
+            ..self
+        }
+    }
+
+    /// True in [deterministic mode](Batch::deterministic).
+    #[must_use]
+    pub fn is_deterministic(&self) -> bool {
+        self.deterministic
     }
 
     /// The same batch forced onto `backend`, for tests and benchmarks.
@@ -296,6 +331,23 @@ impl Batch {
         mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
         let len = checked_len(&local, &xf, &mut out)?;
+        if let (false, Some(local), Some(maps), Some(out)) = (
+            self.deterministic,
+            local.aabb3s(),
+            xf.maps(),
+            out.aabb3s_mut(),
+        ) {
+            let batch = Aos3 {
+                local,
+                maps,
+                out,
+                method: self.method,
+                rounding: self.rounding,
+            };
+            if Class::run_aos3(batch, self.backend) {
+                return Ok(());
+            }
+        }
         let run = Run {
             local,
             xf,
@@ -304,7 +356,7 @@ impl Batch {
             method: self.method,
             rounding: self.rounding,
         };
-        simd::dispatch(self.backend, RunN::<N, _, _, _>(run));
+        simd::dispatch(self.backend, !self.deterministic, RunN::<N, _, _, _>(run));
         Ok(())
     }
 }

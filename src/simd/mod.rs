@@ -115,34 +115,43 @@ pub(crate) trait Job {
     fn run<L: LaneArray>(self);
 }
 
-/// Runs `job` on `backend`, which the caller has checked is supported.
+/// Runs `job` on `backend`, which the caller has checked is supported; `fused` lets the
+/// AVX2 and AVX-512 lanes fuse multiply-adds. Unfused, every backend does the same
+/// arithmetic as the scalar reference (`wide` then runs the baseline lanes, since its
+/// fusing is fixed at compile time).
 #[allow(unsafe_code)] // the one place: calling the `#[target_feature]` wrappers
-pub(crate) fn dispatch<J: Job>(backend: Backend, job: J) {
+pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     debug_assert!(backend.is_supported());
-    match backend {
-        Backend::Scalar => job.run::<f32>(),
-        Backend::Baseline => job.run::<F32s<8, false>>(),
-        Backend::Wide => job.run::<wide::f32x8>(),
+    match (backend, fused) {
+        (Backend::Scalar, _) => job.run::<f32>(),
+        (Backend::Baseline, _) | (Backend::Wide, false) => job.run::<F32s<8, false>>(),
+        (Backend::Wide, true) => job.run::<wide::f32x8>(),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has AVX2 and FMA.
-        Backend::Avx2 => unsafe { run_avx2(job) },
+        (Backend::Avx2, true) => unsafe { run_avx2::<J, F32s<8, true>>(job) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        (Backend::Avx2, false) => unsafe { run_avx2::<J, F32s<8, false>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has
         // AVX-512F and FMA.
-        Backend::Avx512 => unsafe { run_avx512(job) },
+        (Backend::Avx512, true) => unsafe { run_avx512::<J, F32s<16, true>>(job) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        (Backend::Avx512, false) => unsafe { run_avx512::<J, F32s<16, false>>(job) },
         #[cfg(not(target_arch = "x86_64"))]
-        Backend::Avx2 | Backend::Avx512 => job.run::<F32s<8, false>>(),
+        (Backend::Avx2 | Backend::Avx512, _) => job.run::<F32s<8, false>>(),
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn run_avx2<J: Job>(job: J) {
-    job.run::<F32s<8, true>>();
+fn run_avx2<J: Job, L: LaneArray>(job: J) {
+    job.run::<L>();
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
-fn run_avx512<J: Job>(job: J) {
-    job.run::<F32s<16, true>>();
+fn run_avx512<J: Job, L: LaneArray>(job: J) {
+    job.run::<L>();
 }

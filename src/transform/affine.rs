@@ -3,10 +3,12 @@
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
 use super::{Class, Fields, MAX_FIELDS, Simd3, Transform2, Transform3, vector_at};
+use crate::batch::Aos3;
 use crate::extended::ExtendedMap;
 use crate::kernel::AffineLanes;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;
+use crate::simd::Backend;
 
 /// Fields `[m00, m10, m20, m01, …, m22, t0, t1, t2]`: the columns, then the translation.
 impl Fields for Affine3A {
@@ -34,6 +36,9 @@ impl Fields for Affine3A {
 }
 
 impl Class<3> for Affine3A {
+    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+        batch.run(backend)
+    }
     type Lanes<L: Lane> = AffineLanes<Vector<L, 3>, 3>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {

@@ -84,8 +84,10 @@ pub(crate) mod sealed {
     //! becomes lanes, its kernel and its extended-range form.
 
     use super::*;
+    use crate::batch::Aos3;
     use crate::extended::ExtendedMap;
     use crate::lane::{Lane, Vector};
+    use crate::simd::Backend;
 
     /// The most `f32` fields any stored type has (`Affine3A`: 12).
     pub const MAX_FIELDS: usize = 12;
@@ -133,6 +135,13 @@ pub(crate) mod sealed {
         fn extended(&self) -> ExtendedMap<N>;
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
+        /// Runs a 3D AoS batch on the single-box path and returns true, or returns false
+        /// where the class or the backend has none (2D classes, the scalar and `wide`
+        /// backends).
+        fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+            let _ = (batch, backend);
+            false
+        }
     }
 
     /// A 3D class on glam's SIMD `Vec3A`, whose lanes are the axes of one box.

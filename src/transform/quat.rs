@@ -8,10 +8,12 @@
 use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
 use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform3, vector_at};
+use crate::batch::Aos3;
 use crate::extended::ExtendedMap;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
+use crate::simd::Backend;
 
 /// A rotation then a translation: `x ↦ R(q)·x + t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -321,6 +323,9 @@ impl Fields for Trs3 {
 }
 
 impl Class<3> for Rigid3 {
+    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+        batch.run(backend)
+    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
@@ -335,6 +340,9 @@ impl Class<3> for Rigid3 {
 }
 
 impl Class<3> for Similarity3 {
+    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+        batch.run(backend)
+    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
@@ -350,6 +358,9 @@ impl Class<3> for Similarity3 {
 }
 
 impl Class<3> for Trs3 {
+    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+        batch.run(backend)
+    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {

@@ -3,10 +3,12 @@
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
 use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform2, Transform3, vector_at};
+use crate::batch::Aos3;
 use crate::extended::ExtendedMap;
 use crate::kernel;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;
+use crate::simd::Backend;
 
 /// A 3D translation `x ↦ x + t`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -111,6 +113,9 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
+    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
+        batch.run(backend)
+    }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
