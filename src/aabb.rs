@@ -177,9 +177,9 @@ impl Aabb2 {
 /// Fields `[min.x, min.y, min.z, max.x, max.y, max.z]`; blocks pad with `EMPTY`.
 impl Fields for Aabb3 {
     const FIELDS: usize = 6;
-    type Array<C> = [C; 6];
+    type Array<C: Send + Sync> = [C; 6];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::EMPTY;
@@ -197,9 +197,9 @@ impl Fields for Aabb3 {
 /// Fields `[min.x, min.y, max.x, max.y]`; blocks pad with `EMPTY`.
 impl Fields for Aabb2 {
     const FIELDS: usize = 4;
-    type Array<C> = [C; 4];
+    type Array<C: Send + Sync> = [C; 4];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::EMPTY;

@@ -77,6 +77,15 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
     fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
         B::aabb3s_mut(self)
     }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = &'p mut [B]
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<&mut [B]> {
+        self.chunks_mut(chunk).collect()
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
@@ -154,6 +163,15 @@ impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
     }
     fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
         E::aabb3s_mut(self.as_mut_slice())
+    }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = &'p mut [E]
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<&mut [E]> {
+        self.chunks_mut(chunk).collect()
     }
 }
 

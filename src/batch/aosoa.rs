@@ -217,6 +217,15 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
             fields[N + a][i % 8] = max[a];
         }
     }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = &'p mut [Block8<B>]
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<&mut [Block8<B>]> {
+        self.chunks_mut(chunk / 8).collect()
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
@@ -262,6 +271,15 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
     }
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);
+    }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = &'p mut [Block8<B>]
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<&mut [Block8<B>]> {
+        self.chunks_mut(chunk / 8).collect()
     }
 }
 

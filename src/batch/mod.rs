@@ -20,6 +20,8 @@
 mod aos;
 mod aos3;
 mod aosoa;
+#[cfg(feature = "rayon")]
+mod parallel;
 mod soa;
 
 use core::fmt;
@@ -128,6 +130,15 @@ pub(crate) mod sealed {
         fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
             None
         }
+        /// A part of the sink: the same layout over a run of boxes.
+        #[cfg(feature = "rayon")]
+        type Part<'p>: WriteBoxes<N> + Send
+        where
+            Self: 'p;
+        /// Disjoint parts of `chunk` boxes each, in order (the last may be shorter);
+        /// `chunk` is a multiple of 16, so that parts start on whole AoSoA and lane blocks.
+        #[cfg(feature = "rayon")]
+        fn parts(&mut self, chunk: usize) -> Vec<Self::Part<'_>>;
     }
 
     /// Transforms to read.

@@ -272,6 +272,24 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
             columns[N + a][i] = max[a];
         }
     }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = SoaMut<'p, B>
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, B>> {
+        let len = self.columns.as_ref().first().map_or(0, |c| c.len());
+        let mut columns: Vec<_> = self
+            .columns
+            .as_mut()
+            .iter_mut()
+            .map(|c| c.chunks_mut(chunk))
+            .collect();
+        (0..len.div_ceil(chunk))
+            .map(|_| SoaMut::new(B::array(|n| columns[n].next().unwrap_or_default())))
+            .collect()
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
@@ -336,6 +354,24 @@ where
     }
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.view_mut().set(i, min, max);
+    }
+    #[cfg(feature = "rayon")]
+    type Part<'p>
+        = SoaMut<'p, E>
+    where
+        Self: 'p;
+    #[cfg(feature = "rayon")]
+    fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, E>> {
+        let len = self.columns.as_ref().first().map_or(0, Vec::len);
+        let mut columns: Vec<_> = self
+            .columns
+            .as_mut()
+            .iter_mut()
+            .map(|c| c.chunks_mut(chunk))
+            .collect();
+        (0..len.div_ceil(chunk))
+            .map(|_| SoaMut::new(E::array(|n| columns[n].next().unwrap_or_default())))
+            .collect()
     }
 }
 

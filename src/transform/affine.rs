@@ -13,9 +13,9 @@ use crate::simd::Backend;
 /// Fields `[m00, m10, m20, m01, …, m22, t0, t1, t2]`: the columns, then the translation.
 impl Fields for Affine3A {
     const FIELDS: usize = 12;
-    type Array<C> = [C; 12];
+    type Array<C: Send + Sync> = [C; 12];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Affine3A::IDENTITY;
@@ -76,9 +76,9 @@ impl Transform3 for Affine3A {}
 /// Fields `[m00, m10, m01, m11, t0, t1]`.
 impl Fields for Affine2 {
     const FIELDS: usize = 6;
-    type Array<C> = [C; 6];
+    type Array<C: Send + Sync> = [C; 6];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Affine2::IDENTITY;

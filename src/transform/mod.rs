@@ -103,13 +103,13 @@ pub(crate) mod sealed {
     }
 
     /// A plain-data type stored as `FIELDS` floats: the unit of the AoSoA and SoA layouts.
-    pub trait Fields: Copy {
+    pub trait Fields: Copy + Send + Sync {
         /// The number of `f32` fields.
         const FIELDS: usize;
         /// `[C; FIELDS]`: one `C` per field (a lane block, a column, …).
-        type Array<C>: AsRef<[C]> + AsMut<[C]>;
+        type Array<C: Send + Sync>: AsRef<[C]> + AsMut<[C]> + Send + Sync;
         /// The array whose entry `n` is `f(n)`.
-        fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C>;
+        fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C>;
         /// The value that pads a partial AoSoA block (the identity, or the empty box).
         const PADDING: Self;
         /// The fields, in their fixed order; entries past `FIELDS` are zero.

@@ -269,9 +269,9 @@ fn quat_of(f: &[f32; MAX_FIELDS]) -> Quat {
 
 impl Fields for Rigid3 {
     const FIELDS: usize = 7;
-    type Array<C> = [C; 7];
+    type Array<C: Send + Sync> = [C; 7];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::IDENTITY;
@@ -287,9 +287,9 @@ impl Fields for Rigid3 {
 
 impl Fields for Similarity3 {
     const FIELDS: usize = 8;
-    type Array<C> = [C; 8];
+    type Array<C: Send + Sync> = [C; 8];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::IDENTITY;
@@ -305,9 +305,9 @@ impl Fields for Similarity3 {
 
 impl Fields for Trs3 {
     const FIELDS: usize = 10;
-    type Array<C> = [C; 10];
+    type Array<C: Send + Sync> = [C; 10];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::IDENTITY;

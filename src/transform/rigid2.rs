@@ -124,9 +124,9 @@ impl<L: Lane> MapKernel<Vector<L, 2>> for Rigid2Lanes<L> {
 /// Fields `[cos, sin, t0, t1]`.
 impl Fields for Rigid2 {
     const FIELDS: usize = 4;
-    type Array<C> = [C; 4];
+    type Array<C: Send + Sync> = [C; 4];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Rigid2::IDENTITY;

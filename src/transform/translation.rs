@@ -94,9 +94,9 @@ impl<V: Lane> MapKernel<V> for TranslationLanes<V> {
 /// Fields `[t0, t1, t2]`.
 impl Fields for Translation3 {
     const FIELDS: usize = 3;
-    type Array<C> = [C; 3];
+    type Array<C: Send + Sync> = [C; 3];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::IDENTITY;
@@ -143,9 +143,9 @@ impl Transform3 for Translation3 {}
 /// Fields `[t0, t1]`.
 impl Fields for Translation2 {
     const FIELDS: usize = 2;
-    type Array<C> = [C; 2];
+    type Array<C: Send + Sync> = [C; 2];
     #[inline(always)]
-    fn array<C>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
+    fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C> {
         core::array::from_fn(f)
     }
     const PADDING: Self = Self::IDENTITY;

@@ -1,0 +1,108 @@
+//! Parallel batches on the rayon pool (feature `rayon`).
+//!
+//! The output is split into parts of whole lane blocks; each part runs the serial batch on
+//! a window of the inputs. Every box is computed by the same code whichever part it falls
+//! in (the tail runs in one lane of the same arithmetic), so the result is bit-identical
+//! to [`Batch::transform`] on the same backend.
+
+use rayon::prelude::*;
+
+use super::sealed::{ReadBoxes, ReadMaps};
+use super::{Batch, BatchError, BoxSink, BoxSource, Maps, TransformSource, checked_len};
+use crate::aabb::Aabb3;
+use crate::lane::Vector;
+use crate::simd::LaneArray;
+use crate::transform::Class;
+
+/// The fewest boxes a part gets: below this the pool's overhead outweighs the work.
+const MIN_PART: usize = 4096;
+
+/// Items `start..start + len` of a source.
+struct Window<'a, S> {
+    src: &'a S,
+    start: usize,
+    len: usize,
+}
+
+impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
+    fn len(&self) -> Result<usize, BatchError> {
+        Ok(self.len)
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
+        self.src.load(self.start + i, count)
+    }
+    fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
+        self.src.get(self.start + i)
+    }
+    fn aabb3s(&self) -> Option<&[Aabb3]> {
+        self.src.aabb3s()?.get(self.start..self.start + self.len)
+    }
+}
+
+impl<const N: usize, S: ReadMaps<N>> ReadMaps<N> for Window<'_, S> {
+    type Class = S::Class;
+    fn len(&self) -> Option<usize> {
+        self.src.len().map(|_| self.len)
+    }
+    #[inline(always)]
+    fn load<L: LaneArray>(&self, i: usize, count: usize) -> <S::Class as Class<N>>::Lanes<L> {
+        self.src.load(self.start + i, count)
+    }
+    fn get(&self, i: usize) -> S::Class {
+        self.src.get(self.start + i)
+    }
+    fn maps(&self) -> Option<Maps<'_, S::Class>> {
+        match self.src.maps()? {
+            Maps::Each(items) => items.get(self.start..self.start + self.len).map(Maps::Each),
+            Maps::Shared(item) => Some(Maps::Shared(item)),
+        }
+    }
+}
+
+impl Batch {
+    /// [`Batch::transform`] on the rayon pool: the same checks, and bit-identical results
+    /// (on the same backend, in either mode). Parts are at least 4096 boxes, about four per
+    /// thread, so a small batch runs on the calling thread.
+    ///
+    /// # Errors
+    /// As [`Batch::transform`]; `out` is then untouched.
+    pub fn transform_par<const N: usize, B, X, O>(
+        &self,
+        local: B,
+        xf: X,
+        mut out: O,
+    ) -> Result<(), BatchError>
+    where
+        B: BoxSource<N> + Sync,
+        X: TransformSource<N> + Sync,
+        O: BoxSink<N>,
+    {
+        let len = checked_len(&local, &xf, &mut out)?;
+        let parts_wanted = 4 * rayon::current_num_threads();
+        let chunk = len
+            .div_ceil(parts_wanted)
+            .max(MIN_PART)
+            .next_multiple_of(16);
+        out.parts(chunk)
+            .into_par_iter()
+            .enumerate()
+            .try_for_each(|(k, part)| {
+                let start = k * chunk;
+                let len = chunk.min(len - start);
+                self.transform(
+                    Window {
+                        src: &local,
+                        start,
+                        len,
+                    },
+                    Window {
+                        src: &xf,
+                        start,
+                        len,
+                    },
+                    part,
+                )
+            })
+    }
+}
