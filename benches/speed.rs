@@ -1,0 +1,126 @@
+//! Where users call bvkit, in one process: a hand-written glam loop and a parry3d loop,
+//! single-box calls, AoS, SoA and AoSoA batches on the best backend, and the memory
+//! rooflines, at 256 (L1), 1K, 64K and 4M boxes, for affine maps and rigid poses.
+//! `cargo bench --bench speed`; `scripts/bench_report.py speed` tabulates a run.
+
+mod common;
+
+use std::hint::black_box;
+
+use bvkit::{
+    Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rigid3, Rigid3x8,
+    Rounding, Soa,
+};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+
+use common::*;
+
+const SIZES: [(usize, &str); 4] = [
+    (1 << 8, "256"),
+    (1 << 10, "1K"),
+    (1 << 16, "64K"),
+    (1 << 22, "4M"),
+];
+
+const KERNELS: [(Method, Rounding); 4] = [
+    (Method::AbsMatrix, Rounding::Nearest),
+    (Method::AbsMatrix, Rounding::Outward),
+    (Method::SignSelect, Rounding::Nearest),
+    (Method::SignSelect, Rounding::Outward),
+];
+
+fn bench(c: &mut Criterion) {
+    eprintln!("best backend: {:?}", Backend::detect());
+    for (n, size) in SIZES {
+        let s = class_scene(n, 0x5eed);
+        let boxes = &s.boxes;
+        let (b8, x8, r8) = (
+            Aabb3x8::pack(boxes),
+            Affine3x8::pack(&s.affine),
+            Rigid3x8::pack(&s.rigid),
+        );
+        let (bs, xs, rs) = (
+            AabbSoa::from_slice(boxes),
+            Affine3Soa::from_slice(&s.affine),
+            Soa::<Rigid3>::from_slice(&s.rigid),
+        );
+        let (pb, pp) = parry_scene(boxes, &s.poses);
+        let (braw, xraw, rraw) = (
+            raw(&b8, |b| b.fields),
+            raw(&x8, |x| x.fields),
+            raw(&r8, |x| x.fields),
+        );
+        let mut oraw = braw.clone();
+        let mut o8 = vec![Aabb3x8::default(); b8.len()];
+        let mut os = AabbSoa::filled(n, Aabb3::EMPTY);
+        let mut oa = vec![Aabb3::EMPTY; n];
+        let mut op = pb.clone();
+
+        let mut g = c.benchmark_group(format!("speed/{size}"));
+        g.throughput(Throughput::Elements(n as u64));
+        configure(&mut g, n);
+
+        g.bench_function("roofline/aos", |b| {
+            b.iter(|| roofline_aos(black_box(boxes), black_box(&s.affine), &mut oa))
+        });
+        g.bench_function("roofline/soa", |b| {
+            b.iter(|| roofline_soa(black_box(&bs), black_box(&xs), &mut os))
+        });
+        g.bench_function("roofline/aosoa", |b| {
+            b.iter(|| roofline_blocks(black_box(&braw), black_box(&xraw), &mut oraw))
+        });
+        g.bench_function("roofline/aosoa-rigid", |b| {
+            b.iter(|| roofline_blocks(black_box(&braw), black_box(&rraw), &mut oraw))
+        });
+        g.bench_function("peer/glam-abs-matrix", |b| {
+            b.iter(|| glam_abs_matrix(black_box(boxes), black_box(&s.affine), &mut oa))
+        });
+        g.bench_function("peer/glam-rigid-abs-matrix", |b| {
+            b.iter(|| glam_rigid_abs_matrix(black_box(boxes), black_box(&s.rigid), &mut oa))
+        });
+        g.bench_function("peer/parry3d-transform_by", |b| {
+            b.iter(|| parry_transform_by(black_box(&pb), black_box(&pp), &mut op))
+        });
+
+        for (method, rounding) in KERNELS {
+            let kernel = format!("{}/{}", method.name(), rounding.name());
+            let batch = Batch::new(method, rounding);
+            g.bench_function(BenchmarkId::new("single", &kernel), |b| {
+                b.iter(|| {
+                    for ((bx, xf), o) in black_box(boxes).iter().zip(&s.affine).zip(&mut oa) {
+                        *o = bx.transformed(xf, method, rounding);
+                    }
+                })
+            });
+            g.bench_function(BenchmarkId::new("single-rigid", &kernel), |b| {
+                b.iter(|| {
+                    for ((bx, xf), o) in black_box(boxes).iter().zip(&s.rigid).zip(&mut oa) {
+                        *o = bx.transformed(xf, method, rounding);
+                    }
+                })
+            });
+            g.bench_function(BenchmarkId::new("aos", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(boxes), black_box(&s.affine), &mut oa))
+            });
+            g.bench_function(BenchmarkId::new("aos-rigid", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(boxes), black_box(&s.rigid), &mut oa))
+            });
+            g.bench_function(BenchmarkId::new("soa", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(&bs), black_box(&xs), &mut os))
+            });
+            g.bench_function(BenchmarkId::new("soa-rigid", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(&bs), black_box(&rs), &mut os))
+            });
+            g.bench_function(BenchmarkId::new("aosoa", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(&b8), black_box(&x8), &mut o8))
+            });
+            g.bench_function(BenchmarkId::new("aosoa-rigid", &kernel), |b| {
+                b.iter(|| batch.transform(black_box(&b8), black_box(&r8), &mut o8))
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
