@@ -75,6 +75,8 @@ mod projective;
 mod simd;
 mod single;
 pub mod transform;
+// Local-frame AABB trees (issue 11).
+pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
