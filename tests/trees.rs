@@ -5,9 +5,9 @@
 //! - the triangle test against an exact separating-axis reference;
 //! - errors, refit, layouts and their sizes.
 
+mod sat;
 mod trimesh;
 
-use std::cmp::Ordering;
 use std::ops::ControlFlow;
 
 use bvkit::tree::{
@@ -15,162 +15,9 @@ use bvkit::tree::{
     triangles_intersect,
 };
 use bvkit::{Aabb3, Rigid3};
-use glam::{DMat3, DVec3, Quat, Vec3, Vec3A};
-use num_bigint::BigInt;
-use num_traits::{Signed, Zero};
+use glam::{DVec3, Quat, Vec3, Vec3A};
+use sat::{exact_overlap, exact_triangles};
 use trimesh::Uniform;
-
-// ---------------------------------------------------------------------------------------
-// Exact dyadic arithmetic: every finite f64 is `m·2^e`; sums and products stay dyadic.
-// (The crate's fixed-point oracle stops at products of four f32 values; the relative map
-// is an f64 matrix and the cross axes are products of three of its entries, so this test
-// carries its own exponent.)
-
-#[derive(Clone, Debug)]
-struct Dy {
-    m: BigInt,
-    e: i32,
-}
-
-impl Dy {
-    fn of(x: f64) -> Dy {
-        assert!(x.is_finite());
-        if x == 0.0 {
-            return Dy {
-                m: BigInt::zero(),
-                e: 0,
-            };
-        }
-        let bits = x.to_bits();
-        let biased = ((bits >> 52) & 0x7ff) as i32;
-        let frac = (bits & ((1u64 << 52) - 1)) as i64;
-        let (s, e) = if biased == 0 {
-            (frac, -1074)
-        } else {
-            (frac | (1i64 << 52), biased - 1075)
-        };
-        Dy {
-            m: BigInt::from(if x < 0.0 { -s } else { s }),
-            e,
-        }
-    }
-    fn mul(&self, o: &Dy) -> Dy {
-        Dy {
-            m: &self.m * &o.m,
-            e: self.e + o.e,
-        }
-    }
-    fn add(&self, o: &Dy) -> Dy {
-        let e = self.e.min(o.e);
-        Dy {
-            m: (&self.m << (self.e - e) as usize) + (&o.m << (o.e - e) as usize),
-            e,
-        }
-    }
-    fn neg(&self) -> Dy {
-        Dy {
-            m: -&self.m,
-            e: self.e,
-        }
-    }
-    fn sub(&self, o: &Dy) -> Dy {
-        self.add(&o.neg())
-    }
-    fn cmp(&self, o: &Dy) -> Ordering {
-        let d = self.sub(o);
-        if d.m.is_zero() {
-            Ordering::Equal
-        } else if d.m.is_positive() {
-            Ordering::Greater
-        } else {
-            Ordering::Less
-        }
-    }
-    fn min(self, o: Dy) -> Dy {
-        if self.cmp(&o) == Ordering::Greater {
-            o
-        } else {
-            self
-        }
-    }
-    fn max(self, o: Dy) -> Dy {
-        if self.cmp(&o) == Ordering::Less {
-            o
-        } else {
-            self
-        }
-    }
-    fn is_zero(&self) -> bool {
-        self.m.is_zero()
-    }
-}
-
-type V3 = [Dy; 3];
-
-fn v3(v: DVec3) -> V3 {
-    [Dy::of(v.x), Dy::of(v.y), Dy::of(v.z)]
-}
-
-fn cross(a: &V3, b: &V3) -> V3 {
-    [
-        a[1].mul(&b[2]).sub(&a[2].mul(&b[1])),
-        a[2].mul(&b[0]).sub(&a[0].mul(&b[2])),
-        a[0].mul(&b[1]).sub(&a[1].mul(&b[0])),
-    ]
-}
-
-fn dot(a: &V3, b: &V3) -> Dy {
-    a[0].mul(&b[0]).add(&a[1].mul(&b[1])).add(&a[2].mul(&b[2]))
-}
-
-/// The exact projection interval of the box `[lo, hi]` on `l`.
-fn project_box(l: &V3, lo: &V3, hi: &V3) -> (Dy, Dy) {
-    let mut a = Dy::of(0.0);
-    let mut b = Dy::of(0.0);
-    for k in 0..3 {
-        let (p, q) = (l[k].mul(&lo[k]), l[k].mul(&hi[k]));
-        a = a.add(&p.clone().min(q.clone()));
-        b = b.add(&p.max(q));
-    }
-    (a, b)
-}
-
-/// Exact: do the box `a` (in A's frame) and the box `b` placed by `y ↦ M·y + t` share a
-/// point? Separating axes of a box and a parallelepiped: A's 3 face normals, the 3
-/// cofactor normals `M_k × M_l`, and the 9 crosses `e_i × M_j` (complete, degenerate boxes
-/// included; a zero axis never separates and is skipped).
-fn exact_overlap(a: &Aabb3, b: &Aabb3, m: DMat3, t: DVec3) -> bool {
-    let (alo, ahi) = (v3(a.min.as_dvec3()), v3(a.max.as_dvec3()));
-    let (blo, bhi) = (v3(b.min.as_dvec3()), v3(b.max.as_dvec3()));
-    let cols = [v3(m.x_axis), v3(m.y_axis), v3(m.z_axis)];
-    let tt = v3(t);
-    let unit =
-        |i: usize| -> V3 { core::array::from_fn(|k| Dy::of(if k == i { 1.0 } else { 0.0 })) };
-    let mut axes: Vec<V3> = (0..3).map(unit).collect();
-    axes.push(cross(&cols[1], &cols[2]));
-    axes.push(cross(&cols[2], &cols[0]));
-    axes.push(cross(&cols[0], &cols[1]));
-    for i in 0..3 {
-        for c in &cols {
-            axes.push(cross(&unit(i), c));
-        }
-    }
-    for l in axes {
-        if l.iter().all(Dy::is_zero) {
-            continue;
-        }
-        let (a0, a1) = project_box(&l, &alo, &ahi);
-        // l·(M y + t) = (Mᵀ l)·y + l·t
-        let mtl: V3 = core::array::from_fn(|j| dot(&cols[j], &l));
-        let (b0, b1) = project_box(&mtl, &blo, &bhi);
-        let lt = dot(&l, &tt);
-        let (b0, b1) = (b0.add(&lt), b1.add(&lt));
-        if a1.cmp(&b0) == Ordering::Less || b1.cmp(&a0) == Ordering::Less {
-            return false;
-        }
-    }
-    true
-}
 
 fn reach(boxes: &[Aabb3]) -> f32 {
     boxes
@@ -397,50 +244,6 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
 
 // ---------------------------------------------------------------------------------------
 // Triangles.
-
-/// Exact separating-axis reference for two non-degenerate triangles: both normals, the 9
-/// edge crosses and the 6 in-plane edge normals (complete for non-degenerate triangles,
-/// coplanar ones included); touching is intersecting.
-fn exact_triangles(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
-    let (a, b) = (a.map(v3), b.map(v3));
-    let edges = |t: &[V3; 3]| -> [V3; 3] {
-        core::array::from_fn(|i| {
-            let (p, q) = (&t[i], &t[(i + 1) % 3]);
-            core::array::from_fn(|k| q[k].sub(&p[k]))
-        })
-    };
-    let (ea, eb) = (edges(&a), edges(&b));
-    let (na, nb) = (cross(&ea[0], &ea[1]), cross(&eb[0], &eb[1]));
-    let mut axes = vec![na.clone(), nb.clone()];
-    for e in &ea {
-        for f in &eb {
-            axes.push(cross(e, f));
-        }
-        axes.push(cross(&na, e));
-    }
-    for f in &eb {
-        axes.push(cross(&nb, f));
-    }
-    for l in axes {
-        if l.iter().all(Dy::is_zero) {
-            continue;
-        }
-        let pa: Vec<Dy> = a.iter().map(|p| dot(&l, p)).collect();
-        let pb: Vec<Dy> = b.iter().map(|p| dot(&l, p)).collect();
-        let (a0, a1) = (
-            pa.iter().cloned().reduce(Dy::min).unwrap(),
-            pa.iter().cloned().reduce(Dy::max).unwrap(),
-        );
-        let (b0, b1) = (
-            pb.iter().cloned().reduce(Dy::min).unwrap(),
-            pb.iter().cloned().reduce(Dy::max).unwrap(),
-        );
-        if a1.cmp(&b0) == Ordering::Less || b1.cmp(&a0) == Ordering::Less {
-            return false;
-        }
-    }
-    true
-}
 
 fn random_triangle(g: &mut Uniform, spread: f64) -> [DVec3; 3] {
     core::array::from_fn(|_| {
