@@ -14,7 +14,7 @@ use bvkit::tree::{
     AabbTree, Compact, MeshError, Quantized, Query, Relative, TriMesh, triangles_distance_sq,
     triangles_intersect,
 };
-use bvkit::{Aabb3, Rigid3};
+use bvkit::{Aabb3, Rigid3, Similarity3};
 use glam::{DVec3, Quat, Vec3, Vec3A};
 use sat::{exact_overlap, exact_triangles};
 use trimesh::Uniform;
@@ -575,4 +575,49 @@ fn refit_matches_a_fresh_build() {
         assert_eq!(z, y);
     }
     let _: &TriMesh<Compact> = &a;
+}
+
+#[test]
+fn similarity_poses() {
+    // Boxes: the adversarial cases with uniform scales on both poses.
+    let mut g = Uniform(31337);
+    let mut overlapping = 0;
+    for (class, (a, b, pa, pb)) in adversarial_cases().into_iter().step_by(3) {
+        let (sa, sb) = (g.range(0.25, 4.0), g.range(0.25, 4.0));
+        let (sa, sb) = if g.next() < 0.2 { (-sa, sb) } else { (sa, sb) };
+        let pa = Similarity3::new(sa, pa.rotation, pa.translation);
+        let pb = Similarity3::new(sb, pb.rotation, pb.translation);
+        let rel = Relative::similarity(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+        let exact = exact_overlap(&a, &b, rel.matrix(), rel.translation());
+        assert!(
+            rel.overlaps(&a, &b) || !exact,
+            "{class}: {a:?} {b:?} {pa:?} {pb:?}"
+        );
+        overlapping += exact as u32;
+    }
+    assert!(overlapping > 50, "{overlapping}");
+    // Meshes: brute force at scaled poses.
+    let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
+    let a = TriMesh::new(v.clone(), t.clone()).unwrap();
+    let b = TriMesh::new(v, t).unwrap().with_layout::<Quantized>();
+    let mut total = 0;
+    for (k, p) in trimesh::poses(10, 0.6, 21).into_iter().enumerate() {
+        let s = 0.5 + 0.2 * k as f32;
+        let pa = Similarity3::new(1.5, Quat::IDENTITY, Vec3A::ZERO);
+        let pb = Similarity3::new(s, p.rotation, p.translation);
+        let q = Query::similarity(&a, pa, &b, pb);
+        let mut ours = q.overlapping_triangles();
+        ours.sort_unstable();
+        let expected = brute_force(&a, &b, q.relative(), 0.0);
+        assert_eq!(ours, expected, "pose {k}");
+        total += expected.len();
+    }
+    assert!(total > 20, "{total}");
+    // A zero scale places nothing and does not panic.
+    let zero = Similarity3::new(0.0, Quat::IDENTITY, Vec3A::ZERO);
+    assert!(
+        Query::similarity(&a, zero, &b, Similarity3::IDENTITY)
+            .overlapping_triangles()
+            .is_empty()
+    );
 }

@@ -9,7 +9,7 @@ use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Layout, Ref, Store};
 use super::relative::Relative;
 use super::triangle::{triangles_distance_sq, triangles_intersect};
-use crate::transform::Rigid3;
+use crate::transform::{Rigid3, Similarity3};
 
 /// What a tree is built over: [`TriMesh`] or [`AabbTree`] (sealed).
 pub trait Shape: Primitives {}
@@ -65,8 +65,8 @@ pub struct Stats {
 pub struct Query<'a, A, B> {
     a: &'a A,
     b: &'a B,
-    pa: Rigid3,
-    pb: Rigid3,
+    pa: Similarity3,
+    pb: Similarity3,
     tolerance: f32,
     cross_near_leaves: bool,
     relative: Relative,
@@ -76,7 +76,15 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     /// The query between `a` at `pa` and `b` at `pb`, with no tolerance.
     #[must_use]
     pub fn new(a: &'a A, pa: Rigid3, b: &'a B, pb: Rigid3) -> Self {
-        let relative = Relative::new(&pa, a.hierarchy().reach, &pb, b.hierarchy().reach, 0.0);
+        Self::similarity(a, pa.into(), b, pb.into())
+    }
+
+    /// The query between `a` at `pa` and `b` at `pb`, poses with a uniform scale (see
+    /// [`Relative::similarity`]; a zero scale places nothing).
+    #[must_use]
+    pub fn similarity(a: &'a A, pa: Similarity3, b: &'a B, pb: Similarity3) -> Self {
+        let relative =
+            Relative::similarity(&pa, a.hierarchy().reach, &pb, b.hierarchy().reach, 0.0);
         Query {
             a,
             b,
@@ -93,7 +101,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     #[must_use]
     pub fn with_tolerance(mut self, tolerance: f32) -> Self {
         self.tolerance = tolerance;
-        self.relative = Relative::new(
+        self.relative = Relative::similarity(
             &self.pa,
             self.a.hierarchy().reach,
             &self.pb,

@@ -1,24 +1,25 @@
 //! The relative pose of two trees, `|R|` and the one error pad, computed once per query.
 //!
 //! # The geometry a query decides
-//! Object `A` at pose `pa = (qa, ta)` and object `B` at `pb = (qb, tb)`. `B` is placed in
-//! `A`'s frame by the affine map `y ↦ M·y + t` with
-//! `M = R(qa)ᵀ·R(qb)` and `t = R(qa)ᵀ·(tb − ta)`, evaluated in `f64` from the stored `f32`
-//! components (`R(q)` the crate's standard formula on `q` as stored). For unit quaternions
-//! this is `pa⁻¹ ∘ pb` to within a few `2^-52` relative; for any finite pose it is one
-//! well-defined affine map, and the queries are exact or provably conservative **for it**:
-//! triangles of `B` are placed by rounding `M·v + t` to `f64` per vertex, and the leaf test
-//! on those `f64` vertices is exact ([`super::triangle`]).
+//! Object `A` at pose `pa = (qa, ta)` and object `B` at `pb = (qb, tb)` ([`Rigid3`]; a
+//! [`Similarity3`] adds a uniform scale `σ`). `B` is placed in `A`'s frame by the affine map
+//! `y ↦ M·y + t` with `M = (σb/σa)·R(qa)ᵀ·R(qb)` and `t = R(qa)ᵀ·(tb − ta)/σa`, evaluated in
+//! `f64` from the stored `f32` components (`R(q)` the crate's standard formula on `q` as
+//! stored). For unit quaternions this is `pa⁻¹ ∘ pb` to within a few `2^-52` relative; for
+//! any finite pose it is one well-defined affine map, and the queries are exact or provably
+//! conservative **for it**: triangles of `B` are placed by rounding `M·v + t` to `f64` per
+//! vertex, and the leaf test on those `f64` vertices is exact ([`super::triangles_intersect`]).
 //!
 //! # The node-pair test and its pad
 //! A node pair costs two 3-axis tests in `f32` on centers `c` and extents `e`:
 //! - `A`'s axes: separated when `|c_a − (M̃·c_b + t̃)| > e_a + |M̃|·e_b + P` on an axis;
-//! - `B`'s axes: separated when `|c_b − (M̃ᵀ·c_a + t̃_B)| > e_b + |M̃ᵀ|·e_a + P`,
+//! - `B`'s axes: separated when `|c_b − (Ñ·c_a + t̃_B)| > e_b + |Ñ|·e_a + P`,
 //!
-//! with `M̃`, `|M̃|`, `t̃`, `t̃_B ≈ −Mᵀ·t` rounded to `f32` once. `P` is one number per
-//! query. Let `R_a`, `R_b` bound `|coordinate|` of every box of each tree (the trees' reach,
-//! times `1 + 2^-18`), `m` the largest row or column sum of `|M|`, `T` the largest
-//! `|t_i|` or `|(Mᵀt)_i|`, `u = 2^-24`, and `E = MᵀM − I` (zero for an exact rotation).
+//! where `N = (σa/σb)²·Mᵀ` (`= Mᵀ` for rigid poses) stands for `M⁻¹`, and `M̃`, `|M̃|`, `Ñ`,
+//! `|Ñ|`, `t̃`, `t̃_B ≈ −N·t` are rounded to `f32` once. `P` is one number per query. Let
+//! `R_a`, `R_b` bound `|coordinate|` of every box of each tree (the trees' reach, times
+//! `1 + 2^-18`), `m` the largest row or column sum of `|M|` or `|N|`, `T` the largest
+//! `|t_i|` or `|(Nt)_i|`, `u = 2^-24`, and `E = N·M − I` (zero for an exact rotation).
 //!
 //! **Claim.** If a point `x` of box `a` and a point `y` of box `b` have `x = M·y + t + w`
 //! with `|w| <= ε₆₄ + d` (`ε₆₄` the `f64` rounding of a placed vertex, `d` the tolerance),
@@ -36,15 +37,17 @@
 //! products and 3 sums for the radius; one sum adding `P`) moves each side by at most
 //! `γ(5)` of its absolute terms, `<= 6u·(R_a + m·R_b + T)`, plus `u·P`.
 //!
-//! **`B`'s axes.** From `x = My + t + w`, `Mᵀ(x − t − w) = MᵀM·y = y + E·y`, so
-//! `y = Mᵀx − Mᵀt − Mᵀw − E·y`; `|Mᵀw|_j <= m·|w|` and `|E·y|_j <= ‖E‖_F·√3·R_b`. The
-//! rest is the argument above with `A` and `B` exchanged; `t̃_B` adds the `f64` error of
-//! `Mᵀt` (`<= 2^-50·m·T`) to its rounding.
+//! **`B`'s axes.** From `x = My + t + w`, `N(x − t − w) = NM·y = y + E·y`, so
+//! `y = Nx − Nt − Nw − E·y`; `|Nw|_j <= m·|w|` and `|E·y|_j <= ‖E‖_F·√3·R_b`. The rest is
+//! the argument above with `A` and `B` exchanged (`ε_M` also bounds the rounding of `Ñ`);
+//! `t̃_B` adds the `f64` error of `N·t` (`<= 2^-50·m·T`) to its rounding.
 //!
 //! **The pad.** `P = (1 + 2^-20)·[(1 + m)(δ_a + δ_b + ε₆₄ + d) + 3ε_M(R_a + R_b)
 //! + 2(u + 2^-50·m)·T + 2^-148 + ‖E‖_F·√3·R_b + 12u·(1 + m)(R_a + R_b + T)]`, with
-//! `ε₆₄ = 2^-50·(m·R_b + T)`: it exceeds every term of both tests (the factor `1 + 2^-20`
-//! absorbs `u·P` and the `f64` rounding of `P` itself, which is rounded up to `f32`).
+//! `ε₆₄ = 2^-50·(m·R_b + T)` and `‖E‖_F` computed in `f64` plus its rounding
+//! (`9·2^-50·m²`): it exceeds every term of both tests (the factor `1 + 2^-20` absorbs
+//! `u·P` and the `f64` rounding of `P` itself, which is rounded up to `f32`). No constant
+//! in it is tuned: each term is one step of the proof.
 //!
 //! At the root the 9 cross axes `e_i × M_j` (`M_j` a column of `M`) are tested as well, in
 //! `f64` ([`Relative::roots_separated`]): on axis `L` separated when
@@ -55,7 +58,7 @@
 
 use glam::{DMat3, DVec3, Quat, Vec3A};
 
-use crate::transform::Rigid3;
+use crate::transform::{Rigid3, Similarity3};
 
 const U: f64 = 1.0 / 16_777_216.0; // 2^-24
 
@@ -77,6 +80,7 @@ fn rotation(q: Quat) -> DMat3 {
 #[derive(Clone, Copy, Debug)]
 pub struct Relative {
     m: DMat3,
+    n: DMat3,
     t: DVec3,
     cols: [Vec3A; 3],
     abs_cols: [Vec3A; 3],
@@ -95,14 +99,36 @@ impl Relative {
     /// one, gives a relative pose that places nothing ([`Relative::is_valid`] is false).
     #[must_use]
     pub fn new(pa: &Rigid3, reach_a: f32, pb: &Rigid3, reach_b: f32, tolerance: f32) -> Self {
+        Self::similarity(&(*pa).into(), reach_a, &(*pb).into(), reach_b, tolerance)
+    }
+
+    /// The same for poses with a uniform scale: `M = (σb/σa)·R(qa)ᵀ·R(qb)`,
+    /// `t = R(qa)ᵀ·(tb − ta)/σa`, and `B`'s axes tested through `N = (σa/σb)²·Mᵀ` (the
+    /// inverse of `M` for unit quaternions; for [`Rigid3`], `σ = 1` and `N = Mᵀ`). A zero
+    /// scale places nothing.
+    #[must_use]
+    pub fn similarity(
+        pa: &Similarity3,
+        reach_a: f32,
+        pb: &Similarity3,
+        reach_b: f32,
+        tolerance: f32,
+    ) -> Self {
+        let (sa, sb) = (f64::from(pa.scale), f64::from(pb.scale));
         let ra_t = rotation(pa.rotation).transpose();
-        let m = ra_t * rotation(pb.rotation);
-        let t = ra_t * (pb.translation.as_dvec3() - pa.translation.as_dvec3());
+        let m = ra_t * rotation(pb.rotation) * (sb / sa);
+        let t = ra_t * (pb.translation.as_dvec3() - pa.translation.as_dvec3()) / sa;
+        let n = if sa == sb {
+            m.transpose()
+        } else {
+            m.transpose() * ((sa / sb) * (sa / sb))
+        };
         let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.as_vec3a());
-        let mt = m.transpose();
-        let rows = [mt.x_axis, mt.y_axis, mt.z_axis].map(|c| c.as_vec3a());
-        let t_b = -(mt * t);
+        // The columns of N (for a rotation, the rows of M).
+        let rows = [n.x_axis, n.y_axis, n.z_axis].map(|c| c.as_vec3a());
+        let t_b = -(n * t);
         let finite = m.is_finite()
+            && n.is_finite()
             && t.is_finite()
             && reach_a.is_finite()
             && reach_b.is_finite()
@@ -111,12 +137,13 @@ impl Relative {
             && reach_b >= 0.0
             && tolerance >= 0.0;
         let pad = if finite {
-            pad(&m, t, t_b, reach_a, reach_b, tolerance)
+            pad(&m, &n, t, t_b, reach_a, reach_b, tolerance)
         } else {
             f32::NAN
         };
         Relative {
             m,
+            n,
             t,
             cols,
             abs_cols: cols.map(Vec3A::abs),
@@ -228,36 +255,47 @@ impl Relative {
 
     /// The `f64` margin of the root cross-axis test: `2^-46·(1 + m)(R_a + R_b + T)`.
     pub(crate) fn cross_margin(&self, reach_a: f32, reach_b: f32) -> f64 {
-        let (m, t) = norms(&self.m, self.t, self.t_b.as_dvec3());
+        let (m, t) = norms(&self.m, &self.n, self.t, self.t_b.as_dvec3());
         2f64.powi(-46) * (1.0 + m) * (f64::from(reach_a) + f64::from(reach_b) + t)
     }
 }
 
-/// `m` (largest row or column sum of `|M|`) and `T` (largest `|t_i|` or `|t_B,i|`).
-fn norms(m: &DMat3, t: DVec3, t_b: DVec3) -> (f64, f64) {
-    let abs = DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
-    let cols = [abs.x_axis, abs.y_axis, abs.z_axis].map(DVec3::element_sum);
-    let rows = (0..3).map(|i| abs.row(i).element_sum());
-    let m = rows.chain(cols).fold(0.0, f64::max) * (1.0 + 2f64.powi(-40));
+/// `m` (largest row or column sum of `|M|` or `|N|`) and `T` (largest `|t_i|` or `|t_B,i|`).
+fn norms(m: &DMat3, n: &DMat3, t: DVec3, t_b: DVec3) -> (f64, f64) {
+    let sums = |m: &DMat3| {
+        let abs = DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let cols = [abs.x_axis, abs.y_axis, abs.z_axis].map(DVec3::element_sum);
+        let rows = (0..3).map(|i| abs.row(i).element_sum());
+        rows.chain(cols).fold(0.0, f64::max)
+    };
+    let m = sums(m).max(sums(n)) * (1.0 + 2f64.powi(-40));
     let t = t.abs().max_element().max(t_b.abs().max_element()) * (1.0 + 2f64.powi(-40));
     (m, t)
 }
 
 /// The pad `P` of the module docs, rounded up to `f32`.
-fn pad(m: &DMat3, t: DVec3, t_b: DVec3, reach_a: f32, reach_b: f32, tolerance: f32) -> f32 {
-    let (mm, tt) = norms(m, t, t_b);
+fn pad(
+    m: &DMat3,
+    n: &DMat3,
+    t: DVec3,
+    t_b: DVec3,
+    reach_a: f32,
+    reach_b: f32,
+    tolerance: f32,
+) -> f32 {
+    let (mm, tt) = norms(m, n, t, t_b);
     let grow = 1.0 + 2f64.powi(-18);
     let (ra, rb) = (f64::from(reach_a) * grow, f64::from(reach_b) * grow);
     let tiny = 2f64.powi(-148);
     let (delta_a, delta_b) = (2.0 * U * ra + tiny, 2.0 * U * rb + tiny);
-    let max_entry = [m.x_axis, m.y_axis, m.z_axis]
+    let max_entry = [m.x_axis, m.y_axis, m.z_axis, n.x_axis, n.y_axis, n.z_axis]
         .iter()
         .map(|c| c.abs().max_element())
         .fold(0.0, f64::max);
     let eps_m = U * max_entry + 2f64.powi(-150);
     let eps_64 = 2f64.powi(-50) * (mm * rb + tt);
-    // ‖MᵀM − I‖_F computed in f64, plus its own rounding (γ₆₄(3)·m² per entry, 9 entries).
-    let e = m.transpose() * *m - DMat3::IDENTITY;
+    // ‖NM − I‖_F computed in f64, plus its own rounding (γ₆₄(3)·m² per entry, 9 entries).
+    let e = *n * *m - DMat3::IDENTITY;
     let frob = [e.x_axis, e.y_axis, e.z_axis]
         .iter()
         .map(|c| c.length_squared())
