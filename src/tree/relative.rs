@@ -42,12 +42,17 @@
 //! the argument above with `A` and `B` exchanged (`ε_M` also bounds the rounding of `Ñ`);
 //! `t̃_B` adds the `f64` error of `N·t` (`<= 2^-50·m·T`) to its rounding.
 //!
-//! **The pad.** `P = (1 + 2^-20)·[(1 + m)(δ_a + δ_b + ε₆₄ + d) + 3ε_M(R_a + R_b)
-//! + 2(u + 2^-50·m)·T + 2^-148 + ‖E‖_F·√3·R_b + 12u·(1 + m)(R_a + R_b + T)]`, with
-//! `ε₆₄ = 2^-50·(m·R_b + T)` and `‖E‖_F` computed in `f64` plus its rounding
-//! (`9·2^-50·m²`): it exceeds every term of both tests (the factor `1 + 2^-20` absorbs
-//! `u·P` and the `f64` rounding of `P` itself, which is rounded up to `f32`). No constant
-//! in it is tuned: each term is one step of the proof.
+//! **The pad.** With `ε₆₄ = 2^-50·(m·R_b + T)` and `‖E‖_F` computed in `f64` plus its
+//! rounding (`9·2^-50·m²`):
+//!
+//! ```text
+//! P = (1 + 2^-20)·[ (1 + m)(δ_a + δ_b + ε₆₄ + d) + 3ε_M·(R_a + R_b) + 2(u + 2^-50·m)·T
+//!                   + 2^-148 + ‖E‖_F·√3·R_b + 12u·(1 + m)(R_a + R_b + T) ]
+//! ```
+//!
+//! It exceeds every term of both tests (the factor `1 + 2^-20` absorbs `u·P` and the `f64`
+//! rounding of `P` itself, which is rounded up to `f32`). No constant in it is tuned: each
+//! term is one step of the proof.
 //!
 //! At the root the 9 cross axes `e_i × M_j` (`M_j` a column of `M`) are tested as well, in
 //! `f64` ([`Relative::roots_separated`]): on axis `L` separated when
