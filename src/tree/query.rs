@@ -157,22 +157,21 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         if !rel.overlaps_ce(ca, ea, cb, eb) || rel.roots_separated(ca, ea, cb, eb, margin) {
             return ControlFlow::Continue(());
         }
-        let mut stack: Vec<(Ref, Ref)> = Vec::with_capacity(64);
-        stack.push((ha.root, hb.root));
-        while let Some((ra, rb)) = stack.pop() {
-            let split_a = match (ra.is_primitive(), rb.is_primitive()) {
-                (true, true) => {
-                    stats.leaf_pairs += 1;
-                    leaf(ra.index(), rb.index())?;
-                    continue;
-                }
-                (false, true) => true,
-                (true, false) => false,
-                (false, false) => {
-                    let (_, ea) = ha.layout.node_box(ra.index());
-                    let (_, eb) = hb.layout.node_box(rb.index());
-                    ea.element_sum() >= eb.element_sum()
-                }
+        // Each pair on the stack passed its box test; the flag says which side to split,
+        // decided when both boxes were at hand: the node with the larger extent.
+        let split = |ra: Ref, ea: Vec3A, rb: Ref, eb: Vec3A| {
+            !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum())
+        };
+        let mut stack: Vec<(Ref, Ref, bool)> = Vec::with_capacity(64);
+        stack.push((ha.root, hb.root, split(ha.root, ea, hb.root, eb)));
+        while let Some((ra, rb, split_a)) = stack.pop() {
+            if ra.is_primitive() && rb.is_primitive() {
+                stats.leaf_pairs += 1;
+                leaf(ra.index(), rb.index())?;
+                continue;
+            }
+            let leaves = |child: Ref, other: Ref| {
+                self.cross_near_leaves && child.is_primitive() && other.is_primitive()
             };
             if split_a {
                 let (cb, eb) = box_b(rb);
@@ -180,12 +179,9 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                     let (ca, ea) = box_a(child);
                     stats.node_pairs += 1;
                     if rel.overlaps_ce(ca, ea, cb, eb)
-                        && !(self.cross_near_leaves
-                            && child.is_primitive()
-                            && rb.is_primitive()
-                            && rel.roots_separated(ca, ea, cb, eb, margin))
+                        && !(leaves(child, rb) && rel.roots_separated(ca, ea, cb, eb, margin))
                     {
-                        stack.push((child, rb));
+                        stack.push((child, rb, split(child, ea, rb, eb)));
                     }
                 }
             } else {
@@ -194,12 +190,9 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                     let (cb, eb) = box_b(child);
                     stats.node_pairs += 1;
                     if rel.overlaps_ce(ca, ea, cb, eb)
-                        && !(self.cross_near_leaves
-                            && child.is_primitive()
-                            && ra.is_primitive()
-                            && rel.roots_separated(ca, ea, cb, eb, margin))
+                        && !(leaves(child, ra) && rel.roots_separated(ca, ea, cb, eb, margin))
                     {
-                        stack.push((ra, child));
+                        stack.push((ra, child, split(ra, ea, child, eb)));
                     }
                 }
             }

@@ -127,18 +127,59 @@ fn segment_triangle(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
     !(s.contains(&1) && s.contains(&-1))
 }
 
+/// The signs of `u`'s vertices against the plane of `t`, from `n·(p − t₀)` with
+/// `n = (t₁ − t₀) × (t₂ − t₀)` in `f64`, or `None` when one of them is not certain.
+///
+/// The filter: each of the six products `±e₁·e₂·w` of the determinant carries at most 9
+/// roundings (three differences, the cross product's products and difference, the dot
+/// product's products and sums), so the computed value errs by at most
+/// `γ(9)·perm < 2^-49.7·perm` with `perm` the sum of their absolute values; `perm` is itself
+/// computed with at most 6 roundings, so `2^-48·perm` bounds the error. A sign is certain when
+/// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
+/// products could underflow, or not finite) nothing is certain and the exact predicate
+/// decides.
+#[inline(always)]
+fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let n = e1.cross(e2);
+    let na = DVec3::new(
+        (e1.y * e2.z).abs() + (e1.z * e2.y).abs(),
+        (e1.z * e2.x).abs() + (e1.x * e2.z).abs(),
+        (e1.x * e2.y).abs() + (e1.y * e2.x).abs(),
+    );
+    let mut signs = [0i8; 3];
+    for (k, p) in u.iter().enumerate() {
+        let w = *p - t[0];
+        let value = n.dot(w);
+        let perm = na.dot(w.abs());
+        if !(perm >= 2f64.powi(-900) && perm < f64::INFINITY) {
+            return None;
+        }
+        let bound = perm * 2f64.powi(-48);
+        if value > bound {
+            signs[k] = 1;
+        } else if value < -bound {
+            signs[k] = -1;
+        } else {
+            return None;
+        }
+    }
+    Some(signs)
+}
+
+/// True when `u` lies strictly on one side of the plane of `t` (false for a degenerate
+/// `t`, whose orientations are all zero).
+#[inline(always)]
+fn strictly_aside(t: &[DVec3; 3], u: &[DVec3; 3]) -> bool {
+    let s = plane_signs(t, u).unwrap_or_else(|| u.map(|p| o3(t[0], t[1], t[2], p)));
+    s == [1, 1, 1] || s == [-1, -1, -1]
+}
+
 /// True when the closed triangles `a` and `b` share a point (exact; touching counts).
 #[must_use]
 pub fn triangles_intersect(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
-    // The common rejection first: one triangle strictly on one side of the other's plane.
-    let strictly_aside = |t: &[DVec3; 3], u: &[DVec3; 3]| {
-        let s = [
-            o3(t[0], t[1], t[2], u[0]),
-            o3(t[0], t[1], t[2], u[1]),
-            o3(t[0], t[1], t[2], u[2]),
-        ];
-        (s == [1, 1, 1]) || (s == [-1, -1, -1])
-    };
+    // The common rejection first (a filtered, then exact, plane-side test): one triangle
+    // strictly on one side of the other's plane.
     if strictly_aside(a, b) || strictly_aside(b, a) {
         return false;
     }
