@@ -340,9 +340,9 @@ where
 {
     let mut pairs = Vec::new();
     for i in 0..a.triangles().len() as u32 {
-        let ta = a.triangle(i).map(|v| v.as_dvec3());
+        let ta = a.triangle(i).unwrap().map(|v| v.as_dvec3());
         for j in 0..b.triangles().len() as u32 {
-            let tb = b.triangle(j).map(|v| rel.place(v));
+            let tb = b.triangle(j).unwrap().map(|v| rel.place(v));
             let meet = if tolerance > 0.0 {
                 triangles_distance_sq(&ta, &tb) <= f64::from(tolerance).powi(2)
             } else {
@@ -544,6 +544,7 @@ fn bad_input_is_an_error() {
     ];
     let h = TriMesh::new(huge, vec![[0, 1, 2], [2, 1, 0]]).unwrap();
     let hq = h.with_layout::<Quantized>();
+    assert_eq!(h.triangle(2), None);
     let _ = h.overlapping_triangles(
         Rigid3::IDENTITY,
         &hq,
@@ -620,4 +621,27 @@ fn similarity_poses() {
             .overlapping_triangles()
             .is_empty()
     );
+}
+
+#[test]
+fn sums_that_would_overflow_f32_never_separate() {
+    // Found by the `tree` fuzz target: the placed center overflows f32 while the exact
+    // boxes overlap just below f32::MAX.
+    let a = Aabb3::new(
+        Vec3A::new(-0.9887, -8.002_044_4e30, -0.8871),
+        Vec3A::splat(f32::MAX),
+    );
+    let b = Aabb3::new(
+        Vec3A::new(-0.7234, -2_097_152.0, 2.98e-43),
+        Vec3A::new(0.0, 1e30, 1.175_494_4e-38),
+    );
+    let pa = Rigid3::new(Quat::IDENTITY, Vec3A::new(1e30, 1.2556e-41, 0.0));
+    let pb = Rigid3::new(
+        Quat::from_xyzw(0.0, 1.001_403_8, 0.0, 0.0),
+        Vec3A::new(1e30, f32::MAX, f32::MAX),
+    );
+    let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+    assert!(exact_overlap(&a, &b, rel.matrix(), rel.translation()));
+    assert!(rel.overlaps(&a, &b));
+    assert_eq!(rel.pad(), f32::INFINITY);
 }

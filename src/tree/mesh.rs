@@ -228,7 +228,7 @@ impl<L: Layout> TriMesh<L> {
 
     fn prim_boxes(&self) -> Vec<PrimBox> {
         (0..self.triangles.len())
-            .map(|i| prim_box(self.triangle(i as u32)))
+            .map(|i| prim_box(self.corners(i as u32)))
             .collect()
     }
 
@@ -283,10 +283,18 @@ impl<L: Layout> TriMesh<L> {
         &self.triangles
     }
 
-    /// The vertices of triangle `i` (which must exist).
-    #[inline(always)]
+    /// The vertices of triangle `i`, if it exists.
+    #[inline]
     #[must_use]
-    pub fn triangle(&self, i: u32) -> [Vec3; 3] {
+    pub fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+        let t = self.triangles.get(i as usize)?;
+        Some(t.map(|v| self.vertices[v as usize]))
+    }
+
+    /// The vertices of triangle `i`, an id the tree holds (so it exists, and its indices
+    /// were checked at the build).
+    #[inline(always)]
+    pub(crate) fn corners(&self, i: u32) -> [Vec3; 3] {
         let t = self.triangles[i as usize];
         t.map(|v| self.vertices[v as usize])
     }
@@ -306,7 +314,7 @@ impl<L: Layout> TriMesh<L> {
     /// Triangle `i`'s vertices in `f64` (exact).
     #[inline(always)]
     pub(crate) fn triangle_f64(&self, i: u32) -> [DVec3; 3] {
-        self.triangle(i).map(|v| v.as_dvec3())
+        self.corners(i).map(|v| v.as_dvec3())
     }
 }
 

@@ -31,7 +31,7 @@ impl<L: Layout> Primitives for TriMesh<L> {
     }
     #[inline(always)]
     fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A) {
-        triangle_box(self.triangle(id))
+        triangle_box(self.corners(id))
     }
 }
 
@@ -207,7 +207,7 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
     #[inline]
     fn triangles_meet(&self, i: u32, j: u32) -> bool {
         let ta = self.a.triangle_f64(i);
-        let tb: [DVec3; 3] = self.b.triangle(j).map(|v| self.relative.place(v));
+        let tb: [DVec3; 3] = self.b.corners(j).map(|v| self.relative.place(v));
         if self.tolerance > 0.0 {
             let d = f64::from(self.tolerance);
             triangles_distance_sq(&ta, &tb) <= d * d

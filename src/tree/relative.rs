@@ -54,6 +54,11 @@
 //! rounding of `P` itself, which is rounded up to `f32`). No constant in it is tuned: each
 //! term is one step of the proof.
 //!
+//! **Overflow.** The proof assumes no `f32` operation overflows: every value in the tests is
+//! at most `(1 + m)(R_a + R_b + T) + P`. When `(1 + m)(R_a + R_b + T) >= 2^126`, `P` is
+//! `+inf` instead and no pair is culled (an infinite radius never separates; NaN never
+//! separates); the exact leaf test still decides. Found by the `tree` fuzz target.
+//!
 //! At the root the 9 cross axes `e_i × M_j` (`M_j` a column of `M`) are tested as well, in
 //! `f64` ([`Relative::roots_separated`]): on axis `L` separated when
 //! `|L·D| > Σ|L_k| e_a,k + Σ|(MᵀL)_k| e_b,k + ‖L‖₁·(P + 2^-46(1 + m)(R_a + R_b + T))`,
@@ -307,6 +312,11 @@ fn pad(
         .sum::<f64>()
         .sqrt()
         + 9.0 * 2f64.powi(-50) * mm * mm;
+    // Past 2^126 the f32 sums of a node-pair test could overflow (an infinite distance
+    // against a finite radius would separate): no pair is culled there.
+    if (1.0 + mm) * (ra + rb + tt) >= 2f64.powi(126) {
+        return f32::INFINITY;
+    }
     let sum = (1.0 + mm) * (delta_a + delta_b + eps_64 + f64::from(tolerance))
         + 3.0 * eps_m * (ra + rb)
         + 2.0 * (U + 2f64.powi(-50) * mm) * tt
