@@ -97,7 +97,9 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     }
 
     /// Pairs at distance at most `tolerance` count as overlapping (NaN, infinite or
-    /// negative: the query reports nothing).
+    /// negative: the query reports nothing). The boxes are culled conservatively for the
+    /// exact distance; the leaf distance is computed in `f64` (relative error a few
+    /// `2^-52`), so only a zero tolerance is an exact test.
     #[must_use]
     pub fn with_tolerance(mut self, tolerance: f32) -> Self {
         self.tolerance = tolerance;
