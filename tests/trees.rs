@@ -645,3 +645,53 @@ fn sums_that_would_overflow_f32_never_separate() {
     assert!(rel.overlaps(&a, &b));
     assert_eq!(rel.pad(), f32::INFINITY);
 }
+
+#[test]
+fn adversarial_builds_find_every_overlap() {
+    // Exponentially spaced boxes (SAH would peel one per level) and boxes far from the
+    // origin (the quantized grid): the tree still finds every exact overlap.
+    let spaced: Vec<Aabb3> = (0..160)
+        .map(|k| aabb(Vec3::new(1.07f32.powi(k), 0.0, 0.0), Vec3::splat(0.3)))
+        .collect();
+    let far: Vec<Aabb3> = (0..120)
+        .map(|k| {
+            let c = Vec3::new(
+                1.0e5 + (k % 7) as f32 * 0.25,
+                -3.0e5 + (k / 7) as f32 * 0.25,
+                7.0e4,
+            );
+            aabb(c, Vec3::new(0.1, 0.2, 0.0))
+        })
+        .collect();
+    for boxes in [spaced, far] {
+        let compact = AabbTree::new(&boxes).unwrap();
+        let quantized = AabbTree::<Quantized>::build(&boxes).unwrap();
+        for (k, pose) in trimesh::poses(2, 0.3, 8).into_iter().enumerate() {
+            let c0 = boxes[0].center();
+            // B is A turned about A's first box (so that the far boxes still meet).
+            let pose = Rigid3::new(pose.rotation, c0 - pose.rotation * c0);
+            let q = compact.query(Rigid3::IDENTITY, &compact, pose);
+            let (pairs, qpairs) = (
+                q.leaf_pairs(),
+                quantized
+                    .query(Rigid3::IDENTITY, &quantized, pose)
+                    .leaf_pairs(),
+            );
+            let rel = q.relative();
+            let mut exact = 0;
+            for (i, a) in boxes.iter().enumerate() {
+                for (j, b) in boxes.iter().enumerate().step_by(4) {
+                    if exact_overlap(a, b, rel.matrix(), rel.translation()) {
+                        exact += 1;
+                        assert!(pairs.contains(&(i as u32, j as u32)), "compact, pose {k}");
+                        assert!(
+                            qpairs.contains(&(i as u32, j as u32)),
+                            "quantized, pose {k}"
+                        );
+                    }
+                }
+            }
+            assert!(exact > 0);
+        }
+    }
+}

@@ -61,17 +61,26 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
         Root,
         Child(usize, usize),
     }
-    let mut work = vec![(0usize, n, Slot::Root)];
-    while let Some((start, end, slot)) = work.pop() {
+    // Past this depth every split is a median split: SAH alone can peel one primitive per
+    // level off adversarial input (O(n²)); with the guard the depth, and so the work per
+    // primitive, stays O(log n).
+    let max_depth = 2 * (usize::BITS - n.leading_zeros()) as usize + 16;
+    let mut work = vec![(0usize, n, Slot::Root, 0usize)];
+    while let Some((start, end, slot, depth)) = work.pop() {
         let r = if end - start == 1 {
             Ref::primitive(ids[start])
         } else {
             let index = children.len();
             children.push([Ref::primitive(0); 2]);
-            let mid = split(boxes, &mut ids[start..end]) + start;
+            let range = &mut ids[start..end];
+            let mid = if depth < max_depth {
+                split(boxes, range)
+            } else {
+                median(boxes, range)
+            } + start;
             // Right first, so that the left range is placed next (pre-order).
-            work.push((mid, end, Slot::Child(index, 1)));
-            work.push((start, mid, Slot::Child(index, 0)));
+            work.push((mid, end, Slot::Child(index, 1), depth + 1));
+            work.push((start, mid, Slot::Child(index, 0), depth + 1));
             Ref::node(index as u32)
         };
         match slot {
@@ -144,6 +153,30 @@ fn split(boxes: &[PrimBox], ids: &mut [u32]) -> usize {
     } else {
         left
     }
+}
+
+/// Partitions `ids` (at least two) at the median centroid of the widest centroid axis (ties
+/// by id, so deterministic) and returns the size of the left half.
+fn median(boxes: &[PrimBox], ids: &mut [u32]) -> usize {
+    let spread = |k: usize| {
+        let (lo, hi) = ids
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &i| {
+                let c = boxes[i as usize].centroid(k);
+                (l.min(c), h.max(c))
+            });
+        hi - lo
+    };
+    let axis = (0..3).fold(0, |best, k| if spread(k) > spread(best) { k } else { best });
+    let mid = ids.len() / 2;
+    ids.select_nth_unstable_by(mid, |&a, &b| {
+        let (ca, cb) = (
+            boxes[a as usize].centroid(axis),
+            boxes[b as usize].centroid(axis),
+        );
+        ca.total_cmp(&cb).then(a.cmp(&b))
+    });
+    mid
 }
 
 #[inline]
