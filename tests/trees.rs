@@ -259,7 +259,7 @@ fn random_triangle(g: &mut Uniform, spread: f64) -> [DVec3; 3] {
 fn triangle_test_matches_exact_reference() {
     let mut g = Uniform(4242);
     let mut hits = 0;
-    for k in 0..1500 {
+    for k in 0..2500 {
         let a = random_triangle(&mut g, 1.0);
         let mut b = random_triangle(&mut g, 1.0);
         match k % 5 {

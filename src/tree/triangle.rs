@@ -167,11 +167,22 @@ fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
     Some(signs)
 }
 
-/// True when `u` lies strictly on one side of the plane of `t` (false for a degenerate
-/// `t`, whose orientations are all zero).
+/// The sign of `O(a, b, c, d) = ((b − a) × (c − a))·(d − a)`, exact (Shewchuk's `orient3d`
+/// is `−O`).
 #[inline(always)]
-fn strictly_aside(t: &[DVec3; 3], u: &[DVec3; 3]) -> bool {
-    let s = plane_signs(t, u).unwrap_or_else(|| u.map(|p| o3(t[0], t[1], t[2], p)));
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    -o3(a, b, c, d)
+}
+
+/// The signs of `O(t₀, t₁, t₂, u_k)`: filtered, exact where the filter is unsure.
+#[inline(always)]
+fn signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> [i8; 3] {
+    plane_signs(t, u).unwrap_or_else(|| u.map(|p| orient(t[0], t[1], t[2], p)))
+}
+
+/// True when all three signs are the same and not zero.
+#[inline(always)]
+fn aside(s: [i8; 3]) -> bool {
     s == [1, 1, 1] || s == [-1, -1, -1]
 }
 
@@ -180,9 +191,18 @@ fn strictly_aside(t: &[DVec3; 3], u: &[DVec3; 3]) -> bool {
 pub fn triangles_intersect(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
     // The common rejection first (a filtered, then exact, plane-side test): one triangle
     // strictly on one side of the other's plane.
-    if strictly_aside(a, b) || strictly_aside(b, a) {
+    let sb = signs(a, b);
+    if aside(sb) {
         return false;
     }
+    let sa = signs(b, a);
+    if aside(sa) {
+        return false;
+    }
+    if !sa.contains(&0) && !sb.contains(&0) {
+        return crossing(a, b, sa, sb);
+    }
+    // Some vertex on the other plane, coplanar or degenerate: the edge tests.
     let edges = [(0, 1), (1, 2), (2, 0)];
     edges
         .iter()
@@ -190,6 +210,40 @@ pub fn triangles_intersect(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
         || edges
             .iter()
             .any(|&(i, j)| segment_triangle(b[i], b[j], a[0], a[1], a[2]))
+}
+
+/// Guigue and Devillers' test for triangles that each cross the other's plane strictly (no
+/// vertex on the other plane; `sa`, `sb` the signs of `a`'s vertices against `b`'s plane
+/// and of `b`'s against `a`'s, none zero).
+///
+/// Each triangle has one vertex alone on its side; rotating the vertices (which keeps the
+/// orientation) puts it first, as `p₁` and `p₂`, and swapping the other two of the other
+/// triangle puts `p₁` on the positive side of `π₂` and `p₂` on the positive side of `π₁`.
+/// The planes then cut `a` in `[i, j]` (`i` on `p₁q₁`, `j` on `p₁r₁`) and `b` in `[k, l]`,
+/// on the line where the planes meet, and the two intervals overlap iff `k` is not past `j`
+/// and `i` not past `l`, which are the signs of `O(p₁, q₁, p₂, q₂)` and
+/// `O(p₁, r₁, r₂, p₂)` (both `<= 0`); zero is touching, which counts. (The opposite sign
+/// convention fails the exact reference of `tests/trees.rs` at once.)
+fn crossing(a: &[DVec3; 3], b: &[DVec3; 3], sa: [i8; 3], sb: [i8; 3]) -> bool {
+    let lone = |s: [i8; 3]| {
+        if s[0] == s[1] {
+            2
+        } else if s[0] == s[2] {
+            1
+        } else {
+            0
+        }
+    };
+    let (i, j) = (lone(sa), lone(sb));
+    let (p1, mut q1, mut r1) = (a[i], a[(i + 1) % 3], a[(i + 2) % 3]);
+    let (p2, mut q2, mut r2) = (b[j], b[(j + 1) % 3], b[(j + 2) % 3]);
+    if sa[i] < 0 {
+        core::mem::swap(&mut q2, &mut r2);
+    }
+    if sb[j] < 0 {
+        core::mem::swap(&mut q1, &mut r1);
+    }
+    orient(p1, q1, p2, q2) <= 0 && orient(p1, r1, r2, p2) <= 0
 }
 
 /// The squared distance from `p` to the segment `[a, b]` (`f64`, not exact).
