@@ -160,7 +160,8 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             return ControlFlow::Continue(());
         }
         // Each pair on the stack passed its box test; the flag says which side to split,
-        // decided when both boxes were at hand: the node with the larger extent.
+        // decided when both boxes were at hand: the node with the larger extent. A pair of
+        // primitives goes to `leaf` at once (only the roots can be one on the stack).
         let split = |ra: Ref, ea: Vec3A, rb: Ref, eb: Vec3A| {
             !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum())
         };
@@ -172,17 +173,21 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                 leaf(ra.index(), rb.index())?;
                 continue;
             }
-            let leaves = |child: Ref, other: Ref| {
-                self.cross_near_leaves && child.is_primitive() && other.is_primitive()
-            };
             if split_a {
                 let (cb, eb) = box_b(rb);
                 for child in ha.layout.children(ra.index()).into_iter().rev() {
                     let (ca, ea) = box_a(child);
                     stats.node_pairs += 1;
-                    if rel.overlaps_ce(ca, ea, cb, eb)
-                        && !(leaves(child, rb) && rel.roots_separated(ca, ea, cb, eb, margin))
-                    {
+                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                        continue;
+                    }
+                    if child.is_primitive() && rb.is_primitive() {
+                        if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
+                        {
+                            stats.leaf_pairs += 1;
+                            leaf(child.index(), rb.index())?;
+                        }
+                    } else {
                         stack.push((child, rb, split(child, ea, rb, eb)));
                     }
                 }
@@ -191,9 +196,16 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                 for child in hb.layout.children(rb.index()).into_iter().rev() {
                     let (cb, eb) = box_b(child);
                     stats.node_pairs += 1;
-                    if rel.overlaps_ce(ca, ea, cb, eb)
-                        && !(leaves(child, ra) && rel.roots_separated(ca, ea, cb, eb, margin))
-                    {
+                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                        continue;
+                    }
+                    if child.is_primitive() && ra.is_primitive() {
+                        if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
+                        {
+                            stats.leaf_pairs += 1;
+                            leaf(ra.index(), child.index())?;
+                        }
+                    } else {
                         stack.push((ra, child, split(ra, ea, child, eb)));
                     }
                 }
