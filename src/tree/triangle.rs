@@ -138,6 +138,9 @@ fn segment_triangle(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
 /// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
 /// products could underflow, or not finite) nothing is certain and the exact predicate
 /// decides.
+const TWO_POW_M48: f64 = f64::from_bits((1023 - 48) << 52);
+const TWO_POW_M900: f64 = f64::from_bits((1023 - 900) << 52);
+
 #[inline(always)]
 fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
     let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
@@ -152,10 +155,10 @@ fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
         let w = *p - t[0];
         let value = n.dot(w);
         let perm = na.dot(w.abs());
-        if !(perm >= 2f64.powi(-900) && perm < f64::INFINITY) {
+        if !(perm >= TWO_POW_M900 && perm < f64::INFINITY) {
             return None;
         }
-        let bound = perm * 2f64.powi(-48);
+        let bound = perm * TWO_POW_M48;
         if value > bound {
             signs[k] = 1;
         } else if value < -bound {
