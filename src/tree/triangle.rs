@@ -155,7 +155,7 @@ fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
         let w = *p - t[0];
         let value = n.dot(w);
         let perm = na.dot(w.abs());
-        if !(perm >= TWO_POW_M900 && perm < f64::INFINITY) {
+        if !(TWO_POW_M900..f64::INFINITY).contains(&perm) {
             return None;
         }
         let bound = perm * TWO_POW_M48;
