@@ -77,7 +77,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
             .1
             .node_pairs;
     }
-    let tris = b.triangle_count() as f64;
+    let tris = b.triangles().len() as f64;
     println!(
         "{name}: node pairs/query first contact {:.0}, all pairs {:.0}; B/tri compact {:.1}, quantized {:.1}, parry {:.1}",
         first as f64 / n,

@@ -184,22 +184,6 @@ fn bin(c: f64, lo: f64, scale: f64) -> usize {
     (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
-/// The primitives in the order the descent meets them: a depth-first walk, left first.
-pub(crate) fn leaf_order(children: &[[Ref; 2]], root: Ref) -> Vec<u32> {
-    let mut order = Vec::with_capacity(children.len() + 1);
-    let mut stack = vec![root];
-    while let Some(r) = stack.pop() {
-        if r.is_primitive() {
-            order.push(r.index());
-        } else {
-            let [left, right] = children[r.index() as usize];
-            stack.push(right);
-            stack.push(left);
-        }
-    }
-    order
-}
-
 /// The exact box of every node (the union of its primitives' boxes), by one reverse scan
 /// of the pre-order: children follow their parent.
 pub(crate) fn node_boxes(

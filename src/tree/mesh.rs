@@ -92,13 +92,9 @@ pub(crate) struct Hierarchy<L> {
 impl<L: Layout> Hierarchy<L> {
     fn new(boxes: &[PrimBox]) -> Self {
         let topology = build::build(boxes);
-        Self::from_topology(&topology.children, topology.root, boxes)
-    }
-
-    fn from_topology(children: &[[Ref; 2]], root: Ref, boxes: &[PrimBox]) -> Self {
         let mut h = Hierarchy {
-            layout: build::layout(children, |i| boxes[i as usize]),
-            root,
+            layout: build::layout(&topology.children, |i| boxes[i as usize]),
+            root: topology.root,
             reach: 0.0,
         };
         h.reach = h.measure(boxes);
@@ -187,22 +183,11 @@ fn prim_box(p: [Vec3; 3]) -> PrimBox {
 ///
 /// Built once (binned SAH, deterministic); queried at any pair of poses without a rebuild
 /// ([`TriMesh::query`]). The tree costs at most 32 bytes per triangle ([`Compact`]) or 20
-/// ([`super::Quantized`]). The mesh keeps its triangles and vertices in the order the
-/// descent meets them (so that a query reads them nearly in sequence), with the maps back
-/// to the ids it was given (4 bytes per triangle and per vertex): every id it reports or
-/// takes is an original id.
+/// ([`super::Quantized`]); the vertices and triangles are the caller's data.
 #[derive(Clone, Debug)]
 pub struct TriMesh<L: Layout = Compact> {
-    /// Vertices in tree order.
     vertices: Vec<Vec3>,
-    /// Triangles in tree order, indexing `vertices`.
     triangles: Vec<[u32; 3]>,
-    /// Position in tree order → original triangle id.
-    ids: Vec<u32>,
-    /// Original triangle id → position in tree order.
-    positions: Vec<u32>,
-    /// Position in tree order → original vertex id.
-    vertex_ids: Vec<u32>,
     pub(crate) tree: Hierarchy<L>,
 }
 
@@ -228,52 +213,19 @@ impl<L: Layout> TriMesh<L> {
             }
         }
         check_vertices(&vertices)?;
-        let corners = |t: &[u32; 3]| t.map(|v| vertices[v as usize]);
-        let boxes: Vec<PrimBox> = triangles.iter().map(|t| prim_box(corners(t))).collect();
-        let topology = build::build(&boxes);
-        // Tree order: triangles as the descent meets them, vertices by first use.
-        let ids = build::leaf_order(&topology.children, topology.root);
-        let mut positions = vec![0u32; triangles.len()];
-        for (p, &id) in ids.iter().enumerate() {
-            positions[id as usize] = p as u32;
-        }
-        let remap = |r: Ref| {
-            if r.is_primitive() {
-                Ref::primitive(positions[r.index() as usize])
-            } else {
-                r
-            }
+        let mut mesh = TriMesh {
+            vertices,
+            triangles,
+            tree: Hierarchy {
+                layout: L::from_boxes(&[], &[], &[]),
+                root: Ref::primitive(0),
+                reach: 0.0,
+            },
         };
-        let children: Vec<[Ref; 2]> = topology.children.iter().map(|c| c.map(remap)).collect();
-        let mut new_of = vec![u32::MAX; vertices.len()];
-        let mut vertex_ids = Vec::with_capacity(vertices.len());
-        let mut place = |v: u32| {
-            if new_of[v as usize] == u32::MAX {
-                new_of[v as usize] = vertex_ids.len() as u32;
-                vertex_ids.push(v);
-            }
-            new_of[v as usize]
-        };
-        let ordered: Vec<[u32; 3]> = ids
-            .iter()
-            .map(|&id| triangles[id as usize].map(&mut place))
-            .collect();
-        for v in 0..vertices.len() as u32 {
-            place(v); // unused vertices keep a place (refit takes every vertex)
-        }
-        let boxes: Vec<PrimBox> = ids.iter().map(|&id| boxes[id as usize]).collect();
-        let tree = Hierarchy::from_topology(&children, remap(topology.root), &boxes);
-        Ok(TriMesh {
-            vertices: vertex_ids.iter().map(|&v| vertices[v as usize]).collect(),
-            triangles: ordered,
-            ids,
-            positions,
-            vertex_ids,
-            tree,
-        })
+        mesh.tree = Hierarchy::new(&mesh.prim_boxes());
+        Ok(mesh)
     }
 
-    /// The box of every triangle, in tree order.
     fn prim_boxes(&self) -> Vec<PrimBox> {
         (0..self.triangles.len())
             .map(|i| prim_box(self.corners(i as u32)))
@@ -287,16 +239,22 @@ impl<L: Layout> TriMesh<L> {
         TriMesh {
             vertices: self.vertices.clone(),
             triangles: self.triangles.clone(),
-            ids: self.ids.clone(),
-            positions: self.positions.clone(),
-            vertex_ids: self.vertex_ids.clone(),
-            tree: Hierarchy::from_topology(&self.tree.children(), self.tree.root, &boxes),
+            tree: Hierarchy {
+                layout: build::layout(&self.tree.children(), |i| boxes[i as usize]),
+                root: self.tree.root,
+                reach: 0.0,
+            },
         }
+        .measured(&boxes)
     }
 
-    /// Moves the vertices (given in their original order) and refits every node box,
-    /// keeping the topology (for deforming meshes). The count must match, and every vertex
-    /// be finite.
+    fn measured(mut self, boxes: &[PrimBox]) -> Self {
+        self.tree.reach = self.tree.measure(boxes);
+        self
+    }
+
+    /// Moves the vertices and refits every node box, keeping the topology (for deforming
+    /// meshes). The count must match, and every vertex be finite.
     pub fn refit(&mut self, vertices: &[Vec3]) -> Result<(), MeshError> {
         if vertices.len() != self.vertices.len() {
             return Err(MeshError::CountMismatch {
@@ -305,60 +263,46 @@ impl<L: Layout> TriMesh<L> {
             });
         }
         check_vertices(vertices)?;
-        for (slot, &v) in self.vertices.iter_mut().zip(&self.vertex_ids) {
-            *slot = vertices[v as usize];
-        }
+        self.vertices.copy_from_slice(vertices);
         let boxes = self.prim_boxes();
         self.tree.refit(&boxes);
         Ok(())
     }
 
-    /// The number of triangles.
+    /// The vertices.
     #[inline]
     #[must_use]
-    pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
+    pub fn vertices(&self) -> &[Vec3] {
+        &self.vertices
     }
 
-    /// The number of vertices.
+    /// The triangles, as vertex indices.
     #[inline]
     #[must_use]
-    pub fn vertex_count(&self) -> usize {
-        self.vertices.len()
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
     }
 
-    /// The vertices of triangle `id` (an original id), if it exists.
+    /// The vertices of triangle `i`, if it exists.
     #[inline]
     #[must_use]
-    pub fn triangle(&self, id: u32) -> Option<[Vec3; 3]> {
-        let p = *self.positions.get(id as usize)?;
-        Some(self.corners(p))
+    pub fn triangle(&self, i: u32) -> Option<[Vec3; 3]> {
+        let t = self.triangles.get(i as usize)?;
+        Some(t.map(|v| self.vertices[v as usize]))
     }
 
-    /// The vertices of the triangle at position `p` in tree order (which the tree holds, so
-    /// it exists, and its indices were checked at the build).
+    /// The vertices of triangle `i`, an id the tree holds (so it exists, and its indices
+    /// were checked at the build).
     #[inline(always)]
-    pub(crate) fn corners(&self, p: u32) -> [Vec3; 3] {
-        let t = self.triangles[p as usize];
+    pub(crate) fn corners(&self, i: u32) -> [Vec3; 3] {
+        let t = self.triangles[i as usize];
         t.map(|v| self.vertices[v as usize])
     }
 
-    /// The original id of the triangle at position `p` in tree order.
-    #[inline(always)]
-    pub(crate) fn id(&self, p: u32) -> u32 {
-        self.ids[p as usize]
-    }
-
-    /// The bytes of the tree's nodes (vertices, triangles and id maps not included).
+    /// The bytes of the tree's nodes (vertices and triangles not included).
     #[must_use]
     pub fn tree_bytes(&self) -> usize {
         self.tree.node_bytes()
-    }
-
-    /// The bytes of everything the mesh holds: nodes, vertices, triangles and id maps.
-    #[must_use]
-    pub fn total_bytes(&self) -> usize {
-        self.tree_bytes() + self.vertices.len() * (12 + 4) + self.triangles.len() * (12 + 4 + 4)
     }
 
     /// Every box of the tree lies within `±reach()` on every axis.
@@ -367,10 +311,10 @@ impl<L: Layout> TriMesh<L> {
         self.tree.reach
     }
 
-    /// The vertices of the triangle at position `p` in `f64` (exact).
+    /// Triangle `i`'s vertices in `f64` (exact).
     #[inline(always)]
-    pub(crate) fn triangle_f64(&self, p: u32) -> [DVec3; 3] {
-        self.corners(p).map(|v| v.as_dvec3())
+    pub(crate) fn triangle_f64(&self, i: u32) -> [DVec3; 3] {
+        self.corners(i).map(|v| v.as_dvec3())
     }
 }
 

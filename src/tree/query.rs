@@ -18,11 +18,8 @@ pub trait Shape: Primitives {}
 pub(crate) trait Primitives {
     type Nodes: Layout;
     fn hierarchy(&self) -> &Hierarchy<Self::Nodes>;
-    /// The box of the primitive at position `p` (the tree's numbering) as
-    /// `(center, extent)` in the object's frame.
-    fn primitive_box(&self, p: u32) -> (Vec3A, Vec3A);
-    /// The id the caller gave the primitive at position `p`.
-    fn primitive_id(&self, p: u32) -> u32;
+    /// Primitive `id`'s box as `(center, extent)` in the object's frame.
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A);
 }
 
 impl<L: Layout> Shape for TriMesh<L> {}
@@ -33,12 +30,8 @@ impl<L: Layout> Primitives for TriMesh<L> {
         &self.tree
     }
     #[inline(always)]
-    fn primitive_box(&self, p: u32) -> (Vec3A, Vec3A) {
-        triangle_box(self.corners(p))
-    }
-    #[inline(always)]
-    fn primitive_id(&self, p: u32) -> u32 {
-        self.id(p)
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A) {
+        triangle_box(self.corners(id))
     }
 }
 
@@ -50,13 +43,9 @@ impl<L: Layout> Primitives for AabbTree<L> {
         &self.tree
     }
     #[inline(always)]
-    fn primitive_box(&self, p: u32) -> (Vec3A, Vec3A) {
-        let b = &self.boxes()[p as usize];
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A) {
+        let b = &self.boxes()[id as usize];
         (b.center(), b.half_extents())
-    }
-    #[inline(always)]
-    fn primitive_id(&self, p: u32) -> u32 {
-        p
     }
 }
 
@@ -147,10 +136,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         mut leaf: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
         let mut stats = Stats::default();
-        let (a, b) = (self.a, self.b);
-        let flow = self.descend(&mut stats, &mut |i, j| {
-            leaf(a.primitive_id(i), b.primitive_id(j))
-        });
+        let flow = self.descend(&mut stats, &mut leaf);
         (flow, stats)
     }
 
@@ -230,8 +216,8 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
 }
 
 impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
-    /// True when the triangles at positions `i` of `A` and `j` of `B` intersect (exactly,
-    /// touching counts) or, with a tolerance, lie within it (`f64` distance).
+    /// True when triangle `i` of `A` and `j` of `B` intersect (exactly, touching counts)
+    /// or, with a tolerance, lie within it (`f64` distance).
     #[inline]
     fn triangles_meet(&self, i: u32, j: u32) -> bool {
         let ta = self.a.triangle_f64(i);
@@ -250,15 +236,13 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
         &self,
         mut f: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
-        let mut stats = Stats::default();
-        let flow = self.descend(&mut stats, &mut |i, j| {
+        self.visit_boxes(|i, j| {
             if self.triangles_meet(i, j) {
-                f(self.a.id(i), self.b.id(j))
+                f(i, j)
             } else {
                 ControlFlow::Continue(())
             }
-        });
-        (flow, stats)
+        })
     }
 
     /// True when some triangle of `A` meets some triangle of `B` (stops at the first).
