@@ -56,6 +56,12 @@
 //! - Empty boxes map to `EMPTY`; NaN anywhere, or a non-finite matrix, to the invalid
 //!   `NAN` box; unbounded faces to the exact unbounded result (a zero entry contributes
 //!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
+//!
+//! ## Trees
+//! [`tree`] keeps an AABB tree per object in its own frame ([`tree::TriMesh`],
+//! [`tree::AabbTree`]) and tests two objects at any pair of poses with one simultaneous
+//! descent: the relative pose, `|R|` and one derived error pad are computed once per query,
+//! and no node pair that truly overlaps is culled. The leaf triangle test is exact.
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 // The public traits (`Transform3`, `BoxSource`, …) are sealed: their machinery (lane types,
@@ -75,6 +81,8 @@ mod projective;
 mod simd;
 mod single;
 pub mod transform;
+// Local-frame AABB trees (issue 11).
+pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Tabulates one `cargo bench --bench speed` run (criterion's JSON under target/criterion):
+ns per box (criterion's median) for every path at 256, 1K, 64K and 4M boxes, and the
+targets of the speed issue, each marked met or missed.
+
+Usage: python3 scripts/speed_report.py [target/criterion] [GHz]
+GHz converts ns to cycles for the L1-sized batch (default: the clock in /proc/cpuinfo).
+"""
+import json
+import pathlib
+import re
+import sys
+
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/criterion")
+if len(sys.argv) > 2:
+    ghz = float(sys.argv[2])
+else:
+    mhz = re.findall(r"cpu MHz\s*:\s*([0-9.]+)", pathlib.Path("/proc/cpuinfo").read_text())
+    ghz = float(mhz[0]) / 1000 if mhz else 1.0
+
+rows = {}
+for bench in root.glob("**/new/benchmark.json"):
+    meta = json.loads(bench.read_text())
+    group = meta["group_id"]
+    if not group.startswith("speed/"):
+        continue
+    size = group.split("/", 1)[1]
+    name = meta["function_id"] + ("/" + meta["value_str"] if meta.get("value_str") else "")
+    est = json.loads((bench.parent / "estimates.json").read_text())
+    rows[(size, name)] = est["median"]["point_estimate"] / meta["throughput"]["Elements"]
+
+sizes = [s for s in ["256", "1K", "64K", "4M"] if any(k[0] == s for k in rows)]
+names = sorted({k[1] for k in rows}, key=lambda n: (not n.startswith("peer"), not n.startswith("roofline"), n))
+get = lambda s, n: rows.get((s, n))
+
+print("| path | " + " | ".join(f"{s}" for s in sizes) + " |")
+print("|---|" + "---:|" * len(sizes))
+for n in names:
+    print(f"| {n} | " + " | ".join(f"{get(s, n):.2f}" if get(s, n) else "" for s in sizes) + " |")
+
+print()
+print(f"L1-sized batch (256 boxes), cycles per box at {ghz:.2f} GHz:")
+for n in ["aosoa/abs-matrix/nearest", "aosoa/abs-matrix/outward", "aosoa/sign-select/nearest",
+          "aosoa/sign-select/outward", "aosoa-rigid/abs-matrix/nearest", "aosoa-rigid/abs-matrix/outward"]:
+    if get("256", n):
+        print(f"- {n}: {get('256', n) * ghz:.1f} cycles")
+
+print()
+print("| target | measured | |")
+print("|---|---|---|")
+
+
+def target(label, pairs, limit, higher_is_better=False):
+    """pairs: list of (size, numerator, denominator); the ratio must be <= limit."""
+    cells, ok = [], True
+    for s, a, b in pairs:
+        x, y = get(s, a), get(s, b)
+        if x is None or y is None:
+            continue
+        r = y / x if higher_is_better else x / y
+        ok &= r >= limit if higher_is_better else r <= limit
+        cells.append(f"{s}: {r:.2f}×")
+    if cells:
+        print(f"| {label} | {', '.join(cells)} | {'met' if ok else 'missed'} |")
+
+
+for m in ["abs-matrix", "sign-select"]:
+    target(f"single {m} Nearest ≤ 1.0× the glam loop", [("1K", f"single/{m}/nearest", "peer/glam-abs-matrix")], 1.0)
+    target(f"single {m} Outward ≤ 1.2× the glam loop", [("1K", f"single/{m}/outward", "peer/glam-abs-matrix")], 1.2)
+    target(f"single-rigid {m} Nearest ≤ 1.0× the glam rigid loop", [("1K", f"single-rigid/{m}/nearest", "peer/glam-rigid-abs-matrix")], 1.0)
+    target(f"single-rigid {m} Outward ≤ 1.2× the glam rigid loop", [("1K", f"single-rigid/{m}/outward", "peer/glam-rigid-abs-matrix")], 1.2)
+target("AoS abs-matrix Nearest ≥ 2× faster than the glam loop", [("1K", "aos/abs-matrix/nearest", "peer/glam-abs-matrix")], 2.0, True)
+target("AoS rigid abs-matrix Nearest ≥ 8× faster than the parry3d loop", [("1K", "aos-rigid/abs-matrix/nearest", "peer/parry3d-transform_by")], 8.0, True)
+target("AoS abs-matrix Nearest ≥ 8× faster than the parry3d loop", [("1K", "aos/abs-matrix/nearest", "peer/parry3d-transform_by")], 8.0, True)
+for m in ["abs-matrix/nearest", "abs-matrix/outward", "sign-select/nearest", "sign-select/outward"]:
+    target(f"SoA {m} ≤ 1.3× its roofline", [(s, f"soa/{m}", "roofline/soa") for s in ["1K", "64K", "4M"]], 1.3)
+for m in ["abs-matrix/nearest", "abs-matrix/outward", "sign-select/nearest", "sign-select/outward"]:
+    target(f"AoSoA {m} ≤ 1.15× its roofline", [(s, f"aosoa/{m}", "roofline/aosoa") for s in ["1K", "64K"]], 1.15)
+    target(f"AoSoA rigid {m} ≤ 1.15× its roofline", [(s, f"aosoa-rigid/{m}", "roofline/aosoa-rigid") for s in ["1K", "64K"]], 1.15)
+for m in ["abs-matrix", "sign-select"]:
+    target(f"AoSoA {m} Outward ≤ 1.15× Nearest in cache", [(s, f"aosoa/{m}/outward", f"aosoa/{m}/nearest") for s in ["256", "1K", "64K"]], 1.15)
+    target(f"AoSoA rigid {m} Outward ≤ 1.15× Nearest in cache", [(s, f"aosoa-rigid/{m}/outward", f"aosoa-rigid/{m}/nearest") for s in ["256", "1K", "64K"]], 1.15)

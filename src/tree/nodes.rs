@@ -1,0 +1,249 @@
+//! Node layouts: [`Compact`] (32 bytes per node) and [`Quantized`] (20 bytes per node).
+//!
+//! Both are "no-leaf" trees (Opcode's layout): a tree over `n` primitives has `n − 1` inner
+//! nodes, each holding its own box and two child references, and a child is either another
+//! node or a primitive. Primitive boxes are not stored: a mesh derives them from its
+//! triangles at query time. So a tree costs `32·(n − 1)` or `20·(n − 1)` bytes, under 32
+//! and 20 bytes per primitive.
+//!
+//! **Containment.** Every stored box contains, as an exact statement about real numbers,
+//! the union of its primitives' boxes: a compact node stores `center ± extent` with the
+//! extent rounded up past the exact distance to both faces ([`outward`]); a quantized node
+//! stores integers whose exact box `origin + step·(c ± e)` is checked to contain the
+//! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
+//! coordinate (`origin + step·c`); the query pad covers that rounding.
+
+use glam::Vec3A;
+
+/// A child: a node index, or a primitive id with the top bit set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Ref(pub u32);
+
+/// The top bit of a [`Ref`]: set for a primitive.
+pub(crate) const PRIMITIVE: u32 = 1 << 31;
+
+impl Ref {
+    #[inline(always)]
+    pub(crate) fn node(index: u32) -> Self {
+        Ref(index)
+    }
+    #[inline(always)]
+    pub(crate) fn primitive(id: u32) -> Self {
+        Ref(id | PRIMITIVE)
+    }
+    #[inline(always)]
+    pub(crate) fn is_primitive(self) -> bool {
+        self.0 & PRIMITIVE != 0
+    }
+    #[inline(always)]
+    pub(crate) fn index(self) -> u32 {
+        self.0 & !PRIMITIVE
+    }
+}
+
+/// A compact node: `center ± extent` and two children (32 bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Node {
+    pub center: [f32; 3],
+    pub extent: [f32; 3],
+    pub children: [Ref; 2],
+}
+
+/// A quantized node: `origin + step·(center ± extent)` and two children (20 bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct QNode {
+    pub center: [i16; 3],
+    pub extent: [u16; 3],
+    pub children: [Ref; 2],
+}
+
+/// The smallest `f32` at least `x` (for `x >= 0`; `+inf` past the range).
+fn round_up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) < x { y.next_up() } else { y }
+}
+
+/// `center ± extent` containing `[min, max]` exactly: the center is `min/2 + max/2` in
+/// `f32`, and the extent is the larger distance to a face, computed in `f64` (within
+/// `2^-53` relative) and rounded up to `f32`, then raised by one more ulp, which absorbs the
+/// `f64` rounding: the result exceeds the exact distance (the distance between two `f32`
+/// values is `0` or at least `2^-149`, where `f64` is exact).
+pub(crate) fn outward(min: [f32; 3], max: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+    let mut center = [0.0; 3];
+    let mut extent = [0.0; 3];
+    for k in 0..3 {
+        let c = min[k] * 0.5 + max[k] * 0.5;
+        let (lo, hi, c64) = (f64::from(min[k]), f64::from(max[k]), f64::from(c));
+        let d = (hi - c64).max(c64 - lo);
+        center[k] = c;
+        extent[k] = if d > 0.0 { round_up(d).next_up() } else { 0.0 };
+    }
+    (center, extent)
+}
+
+/// How a tree stores its inner nodes: [`Compact`] or [`Quantized`].
+pub trait Layout: Store + Clone + core::fmt::Debug {}
+
+/// The crate-private access every layout gives the builder and the queries.
+pub(crate) trait Store {
+    /// The layout over `children`, whose node `i` has the exact box `[min[i], max[i]]`.
+    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self;
+    /// Node `i` as `(center, extent)`.
+    fn node_box(&self, i: u32) -> (Vec3A, Vec3A);
+    /// The children of node `i`.
+    fn children(&self, i: u32) -> [Ref; 2];
+    /// The number of nodes.
+    fn len(&self) -> usize;
+    /// The bytes of one node.
+    const NODE_BYTES: usize;
+}
+
+/// Nodes of 32 bytes: an `f32` center and extent, two child references.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Compact {
+    nodes: Vec<Node>,
+}
+
+impl Layout for Compact {}
+
+impl Store for Compact {
+    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self {
+        let nodes = children
+            .iter()
+            .zip(min.iter().zip(max))
+            .map(|(&children, (&lo, &hi))| {
+                let (center, extent) = outward(lo, hi);
+                Node {
+                    center,
+                    extent,
+                    children,
+                }
+            })
+            .collect();
+        Compact { nodes }
+    }
+    #[inline(always)]
+    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
+        let n = &self.nodes[i as usize];
+        (Vec3A::from_array(n.center), Vec3A::from_array(n.extent))
+    }
+    #[inline(always)]
+    fn children(&self, i: u32) -> [Ref; 2] {
+        self.nodes[i as usize].children
+    }
+    fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    const NODE_BYTES: usize = core::mem::size_of::<Node>();
+}
+
+/// Nodes of 20 bytes: 16-bit integer centers and extents on a per-tree grid (a power-of-two
+/// step from an `f32` origin), rounded outward at build time, two child references.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Quantized {
+    nodes: Vec<QNode>,
+    origin: Vec3A,
+    step: Vec3A,
+}
+
+impl Layout for Quantized {}
+
+/// The largest grid coordinate used: `|c| + e` stays below `i16::MAX` with room for the
+/// outward steps.
+const GRID: f64 = 32_000.0;
+
+impl Quantized {
+    /// The grid of a tree whose root box is `[lo, hi]`: the origin its `f32` center, the
+    /// step the smallest power of two with `extent / step <= GRID` that is also at least
+    /// `2^-20·|origin|` (so that the `f64` error of the checks below, a few `2^-53·|origin|`,
+    /// is far below one step) and at least `2^-126` (normal).
+    fn grid(lo: [f32; 3], hi: [f32; 3]) -> (Vec3A, Vec3A) {
+        let mut origin = [0.0f32; 3];
+        let mut step = [0.0f32; 3];
+        for k in 0..3 {
+            let o = lo[k] * 0.5 + hi[k] * 0.5;
+            let extent = (f64::from(hi[k]) - f64::from(o)).max(f64::from(o) - f64::from(lo[k]));
+            let need = (extent / GRID)
+                .max(f64::from(o).abs() * 2f64.powi(-20))
+                .max(2f64.powi(-126));
+            // A power of two (exact in f32: at most 2^128 · 2^-15 for finite input).
+            let s = 2f64.powi(need.log2().ceil() as i32);
+            let s = if s < need { s * 2.0 } else { s };
+            origin[k] = o;
+            step[k] = s as f32;
+        }
+        (Vec3A::from_array(origin), Vec3A::from_array(step))
+    }
+
+    /// One node on the grid: `c = round((center − origin)/step)`, and `e` the smallest
+    /// number of steps past the farther face, plus one step that absorbs the `f64` rounding
+    /// of the distances (each within a few `2^-53·(|origin| + extent)`, far below a step by
+    /// the choice of the step). `origin + step·c` is exact in `f64` as a real number only
+    /// up to that rounding, which the extra step covers.
+    fn quantize(origin: Vec3A, step: Vec3A, lo: [f32; 3], hi: [f32; 3]) -> ([i16; 3], [u16; 3]) {
+        let mut c = [0i16; 3];
+        let mut e = [0u16; 3];
+        for k in 0..3 {
+            let (o, s) = (f64::from(origin[k]), f64::from(step[k]));
+            let (l, h) = (f64::from(lo[k]), f64::from(hi[k]));
+            let mid = (l * 0.5 + h * 0.5 - o) / s;
+            let ck = mid.round().clamp(-GRID, GRID);
+            let center = o + ck * s;
+            let reach = ((h - center).max(center - l) / s).max(0.0).ceil() + 1.0;
+            c[k] = ck as i16;
+            e[k] = reach.min(f64::from(u16::MAX)) as u16;
+        }
+        (c, e)
+    }
+}
+
+impl Store for Quantized {
+    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self {
+        let (origin, step) = match (min.first(), max.first()) {
+            (Some(&lo), Some(&hi)) => Self::grid(lo, hi),
+            _ => (Vec3A::ZERO, Vec3A::ONE),
+        };
+        let nodes = children
+            .iter()
+            .zip(min.iter().zip(max))
+            .map(|(&children, (&lo, &hi))| {
+                let (center, extent) = Self::quantize(origin, step, lo, hi);
+                QNode {
+                    center,
+                    extent,
+                    children,
+                }
+            })
+            .collect();
+        Quantized {
+            nodes,
+            origin,
+            step,
+        }
+    }
+    #[inline(always)]
+    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
+        let n = &self.nodes[i as usize];
+        let c = Vec3A::new(
+            f32::from(n.center[0]),
+            f32::from(n.center[1]),
+            f32::from(n.center[2]),
+        );
+        let e = Vec3A::new(
+            f32::from(n.extent[0]),
+            f32::from(n.extent[1]),
+            f32::from(n.extent[2]),
+        );
+        // step·c and step·e are exact (a power of two times a 16-bit integer); the sum
+        // rounds once (relative u), which the query pad's box-rounding term covers.
+        (self.origin + self.step * c, self.step * e)
+    }
+    #[inline(always)]
+    fn children(&self, i: u32) -> [Ref; 2] {
+        self.nodes[i as usize].children
+    }
+    fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    const NODE_BYTES: usize = core::mem::size_of::<QNode>();
+}

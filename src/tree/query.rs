@@ -1,0 +1,326 @@
+//! Queries between two trees at two poses: one simultaneous descent of both trees, with the
+//! relative pose, `|R|` and the pad of [`Relative`] computed once.
+
+use core::ops::ControlFlow;
+
+use glam::{DVec3, Vec3A};
+
+use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
+use super::nodes::{Layout, Ref, Store};
+use super::relative::Relative;
+use super::triangle::{triangles_distance_sq, triangles_intersect};
+use crate::transform::{Rigid3, Similarity3};
+
+/// What a tree is built over: [`TriMesh`] or [`AabbTree`] (sealed).
+pub trait Shape: Primitives {}
+
+/// The crate-private access of the descent: the tree, and a primitive's box.
+pub(crate) trait Primitives {
+    type Nodes: Layout;
+    fn hierarchy(&self) -> &Hierarchy<Self::Nodes>;
+    /// Primitive `id`'s box as `(center, extent)` in the object's frame.
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A);
+}
+
+impl<L: Layout> Shape for TriMesh<L> {}
+impl<L: Layout> Primitives for TriMesh<L> {
+    type Nodes = L;
+    #[inline(always)]
+    fn hierarchy(&self) -> &Hierarchy<L> {
+        &self.tree
+    }
+    #[inline(always)]
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A) {
+        triangle_box(self.corners(id))
+    }
+}
+
+impl<L: Layout> Shape for AabbTree<L> {}
+impl<L: Layout> Primitives for AabbTree<L> {
+    type Nodes = L;
+    #[inline(always)]
+    fn hierarchy(&self) -> &Hierarchy<L> {
+        &self.tree
+    }
+    #[inline(always)]
+    fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A) {
+        let b = &self.boxes()[id as usize];
+        (b.center(), b.half_extents())
+    }
+}
+
+/// The work of one query.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Box pairs tested (nodes and primitive boxes, the roots included).
+    pub node_pairs: u64,
+    /// Primitive pairs whose boxes overlapped (triangle tests, for meshes).
+    pub leaf_pairs: u64,
+}
+
+/// One query between `A` at pose `pa` and `B` at pose `pb`: the relative pose, `|R|` and
+/// the pad are computed here, once (see [`Relative`] for the geometry decided and the
+/// proof that no overlapping pair is culled).
+#[derive(Clone, Copy, Debug)]
+pub struct Query<'a, A, B> {
+    a: &'a A,
+    b: &'a B,
+    pa: Similarity3,
+    pb: Similarity3,
+    tolerance: f32,
+    cross_near_leaves: bool,
+    relative: Relative,
+}
+
+impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
+    /// The query between `a` at `pa` and `b` at `pb`, with no tolerance.
+    #[must_use]
+    pub fn new(a: &'a A, pa: Rigid3, b: &'a B, pb: Rigid3) -> Self {
+        Self::similarity(a, pa.into(), b, pb.into())
+    }
+
+    /// The query between `a` at `pa` and `b` at `pb`, poses with a uniform scale (see
+    /// [`Relative::similarity`]; a zero scale places nothing).
+    #[must_use]
+    pub fn similarity(a: &'a A, pa: Similarity3, b: &'a B, pb: Similarity3) -> Self {
+        let relative =
+            Relative::similarity(&pa, a.hierarchy().reach, &pb, b.hierarchy().reach, 0.0);
+        Query {
+            a,
+            b,
+            pa,
+            pb,
+            tolerance: 0.0,
+            cross_near_leaves: false,
+            relative,
+        }
+    }
+
+    /// Pairs at distance at most `tolerance` count as overlapping (NaN, infinite or
+    /// negative: the query reports nothing). The boxes are culled conservatively for the
+    /// exact distance; the leaf distance is computed in `f64` (relative error a few
+    /// `2^-52`), so only a zero tolerance is an exact test.
+    #[must_use]
+    pub fn with_tolerance(mut self, tolerance: f32) -> Self {
+        self.tolerance = tolerance;
+        self.relative = Relative::similarity(
+            &self.pa,
+            self.a.hierarchy().reach,
+            &self.pb,
+            self.b.hierarchy().reach,
+            tolerance,
+        );
+        self
+    }
+
+    /// Also test the 9 cross axes (in `f64`) on every pair of primitive boxes before the
+    /// leaf is visited. Off by default: measured on the tori and spot scenes, it culls few
+    /// pairs and costs more than it saves (see the README's Trees section).
+    #[must_use]
+    pub fn with_cross_axes_near_leaves(mut self, on: bool) -> Self {
+        self.cross_near_leaves = on;
+        self
+    }
+
+    /// The relative pose of this query.
+    #[must_use]
+    pub fn relative(&self) -> &Relative {
+        &self.relative
+    }
+
+    /// Calls `leaf(i, j)` for every pair of primitives whose boxes overlap by the
+    /// conservative test (a superset of the pairs whose exact boxes overlap or lie within
+    /// the tolerance), until it breaks.
+    pub fn visit_boxes(
+        &self,
+        mut leaf: impl FnMut(u32, u32) -> ControlFlow<()>,
+    ) -> (ControlFlow<()>, Stats) {
+        let mut stats = Stats::default();
+        let flow = self.descend(&mut stats, &mut leaf);
+        (flow, stats)
+    }
+
+    fn descend(
+        &self,
+        stats: &mut Stats,
+        leaf: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let rel = &self.relative;
+        if !rel.is_valid() {
+            return ControlFlow::Continue(());
+        }
+        let (ha, hb) = (self.a.hierarchy(), self.b.hierarchy());
+        let box_a = |r: Ref| ha.box_of(r, |i| self.a.primitive_box(i));
+        let box_b = |r: Ref| hb.box_of(r, |i| self.b.primitive_box(i));
+        let margin = rel.cross_margin(ha.reach, hb.reach);
+        // The roots: 6 axes in f32, then the 9 cross axes in f64.
+        let ((ca, ea), (cb, eb)) = (box_a(ha.root), box_b(hb.root));
+        stats.node_pairs += 1;
+        if !rel.overlaps_ce(ca, ea, cb, eb) || rel.roots_separated(ca, ea, cb, eb, margin) {
+            return ControlFlow::Continue(());
+        }
+        // Each pair on the stack passed its box test; the flag says which side to split,
+        // decided when both boxes were at hand: the node with the larger extent. A pair of
+        // primitives goes to `leaf` at once (only the roots can be one on the stack).
+        let split = |ra: Ref, ea: Vec3A, rb: Ref, eb: Vec3A| {
+            !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum())
+        };
+        let mut stack: Vec<(Ref, Ref, bool)> = Vec::with_capacity(64);
+        stack.push((ha.root, hb.root, split(ha.root, ea, hb.root, eb)));
+        while let Some((ra, rb, split_a)) = stack.pop() {
+            if ra.is_primitive() && rb.is_primitive() {
+                stats.leaf_pairs += 1;
+                leaf(ra.index(), rb.index())?;
+                continue;
+            }
+            if split_a {
+                let (cb, eb) = box_b(rb);
+                for child in ha.layout.children(ra.index()).into_iter().rev() {
+                    let (ca, ea) = box_a(child);
+                    stats.node_pairs += 1;
+                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                        continue;
+                    }
+                    if child.is_primitive() && rb.is_primitive() {
+                        if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
+                        {
+                            stats.leaf_pairs += 1;
+                            leaf(child.index(), rb.index())?;
+                        }
+                    } else {
+                        stack.push((child, rb, split(child, ea, rb, eb)));
+                    }
+                }
+            } else {
+                let (ca, ea) = box_a(ra);
+                for child in hb.layout.children(rb.index()).into_iter().rev() {
+                    let (cb, eb) = box_b(child);
+                    stats.node_pairs += 1;
+                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                        continue;
+                    }
+                    if child.is_primitive() && ra.is_primitive() {
+                        if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
+                        {
+                            stats.leaf_pairs += 1;
+                            leaf(ra.index(), child.index())?;
+                        }
+                    } else {
+                        stack.push((ra, child, split(ra, ea, child, eb)));
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
+    /// True when triangle `i` of `A` and `j` of `B` intersect (exactly, touching counts)
+    /// or, with a tolerance, lie within it (`f64` distance).
+    #[inline]
+    fn triangles_meet(&self, i: u32, j: u32) -> bool {
+        let ta = self.a.triangle_f64(i);
+        let tb: [DVec3; 3] = self.b.corners(j).map(|v| self.relative.place(v));
+        if self.tolerance > 0.0 {
+            let d = f64::from(self.tolerance);
+            triangles_distance_sq(&ta, &tb) <= d * d
+        } else {
+            triangles_intersect(&ta, &tb)
+        }
+    }
+
+    /// Calls `f(i, j)` for every pair of triangles that intersect (or lie within the
+    /// tolerance), until it breaks.
+    pub fn visit(
+        &self,
+        mut f: impl FnMut(u32, u32) -> ControlFlow<()>,
+    ) -> (ControlFlow<()>, Stats) {
+        self.visit_boxes(|i, j| {
+            if self.triangles_meet(i, j) {
+                f(i, j)
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+    }
+
+    /// True when some triangle of `A` meets some triangle of `B` (stops at the first).
+    #[must_use]
+    pub fn intersects(&self) -> bool {
+        self.visit(|_, _| ControlFlow::Break(())).0.is_break()
+    }
+
+    /// Every pair `(i, j)` of triangle ids that meet, in descent order.
+    #[must_use]
+    pub fn overlapping_triangles(&self) -> Vec<(u32, u32)> {
+        let mut pairs = Vec::new();
+        let _ = self.visit(|i, j| {
+            pairs.push((i, j));
+            ControlFlow::Continue(())
+        });
+        pairs
+    }
+}
+
+impl<'a, LA: Layout, LB: Layout> Query<'a, AabbTree<LA>, AabbTree<LB>> {
+    /// Every pair `(i, j)` of primitive ids whose boxes overlap by the conservative test
+    /// (every pair whose exact boxes overlap is among them).
+    #[must_use]
+    pub fn leaf_pairs(&self) -> Vec<(u32, u32)> {
+        let mut pairs = Vec::new();
+        let _ = self.visit_boxes(|i, j| {
+            pairs.push((i, j));
+            ControlFlow::Continue(())
+        });
+        pairs
+    }
+}
+
+impl<L: Layout> TriMesh<L> {
+    /// The query between this mesh at `pose` and `other` at `other_pose`.
+    #[must_use]
+    pub fn query<'a, M: Layout>(
+        &'a self,
+        pose: Rigid3,
+        other: &'a TriMesh<M>,
+        other_pose: Rigid3,
+    ) -> Query<'a, Self, TriMesh<M>> {
+        Query::new(self, pose, other, other_pose)
+    }
+
+    /// True when this mesh at `pose` meets `other` at `other_pose` (first contact).
+    #[must_use]
+    pub fn intersects<M: Layout>(
+        &self,
+        pose: Rigid3,
+        other: &TriMesh<M>,
+        other_pose: Rigid3,
+    ) -> bool {
+        self.query(pose, other, other_pose).intersects()
+    }
+
+    /// Every pair of triangle ids (this mesh's, `other`'s) that meet at these poses.
+    #[must_use]
+    pub fn overlapping_triangles<M: Layout>(
+        &self,
+        pose: Rigid3,
+        other: &TriMesh<M>,
+        other_pose: Rigid3,
+    ) -> Vec<(u32, u32)> {
+        self.query(pose, other, other_pose).overlapping_triangles()
+    }
+}
+
+impl<L: Layout> AabbTree<L> {
+    /// The query between this tree at `pose` and `other` at `other_pose`.
+    #[must_use]
+    pub fn query<'a, M: Layout>(
+        &'a self,
+        pose: Rigid3,
+        other: &'a AabbTree<M>,
+        other_pose: Rigid3,
+    ) -> Query<'a, Self, AabbTree<M>> {
+        Query::new(self, pose, other, other_pose)
+    }
+}

@@ -1,0 +1,333 @@
+//! The relative pose of two trees, `|R|` and the one error pad, computed once per query.
+//!
+//! # The geometry a query decides
+//! Object `A` at pose `pa = (qa, ta)` and object `B` at `pb = (qb, tb)` ([`Rigid3`]; a
+//! [`Similarity3`] adds a uniform scale `σ`). `B` is placed in `A`'s frame by the affine map
+//! `y ↦ M·y + t` with `M = (σb/σa)·R(qa)ᵀ·R(qb)` and `t = R(qa)ᵀ·(tb − ta)/σa`, evaluated in
+//! `f64` from the stored `f32` components (`R(q)` the crate's standard formula on `q` as
+//! stored). For unit quaternions this is `pa⁻¹ ∘ pb` to within a few `2^-52` relative; for
+//! any finite pose it is one well-defined affine map, and the queries are exact or provably
+//! conservative **for it**: triangles of `B` are placed by rounding `M·v + t` to `f64` per
+//! vertex, and the leaf test on those `f64` vertices is exact ([`super::triangles_intersect`]).
+//!
+//! # The node-pair test and its pad
+//! A node pair costs two 3-axis tests in `f32` on centers `c` and extents `e`:
+//! - `A`'s axes: separated when `|c_a − (M̃·c_b + t̃)| > e_a + |M̃|·e_b + P` on an axis;
+//! - `B`'s axes: separated when `|c_b − (Ñ·c_a + t̃_B)| > e_b + |Ñ|·e_a + P`,
+//!
+//! where `N = (σa/σb)²·Mᵀ` (`= Mᵀ` for rigid poses) stands for `M⁻¹`, and `M̃`, `|M̃|`, `Ñ`,
+//! `|Ñ|`, `t̃`, `t̃_B ≈ −N·t` are rounded to `f32` once. `P` is one number per query. Let
+//! `R_a`, `R_b` bound `|coordinate|` of every box of each tree (the trees' reach, times
+//! `1 + 2^-18`), `m` the largest row or column sum of `|M|` or `|N|`, `T` the largest
+//! `|t_i|` or `|(Nt)_i|`, `u = 2^-24`, and `E = N·M − I` (zero for an exact rotation).
+//!
+//! **Claim.** If a point `x` of box `a` and a point `y` of box `b` have `x = M·y + t + w`
+//! with `|w| <= ε₆₄ + d` (`ε₆₄` the `f64` rounding of a placed vertex, `d` the tolerance),
+//! neither test reports the pair separated.
+//!
+//! **Proof, `A`'s axes.** With `ĉ, ê` the exact center and extent of a box and `c, e` the
+//! computed ones, `|x_i − c_a,i| <= e_a,i + δ_a` where `δ <= 2u·R + 2^-148` covers a box
+//! read back from a triangle (`c = lo/2 + hi/2`, `e = hi/2 − lo/2`, one rounding each) or a
+//! quantized node (one rounding of `origin + step·c`); stored compact boxes need none.
+//! Writing `M̃ = M + Δ`, `|Δ_ij| <= ε_M = u·max|M_ij| + 2^-150`, and
+//! `t̃ = t + τ`, `|τ_i| <= u·T + 2^-150`:
+//! `(M̃c_b + t̃ − x)_i = Σ_j M̃_ij (c_b − y)_j + (Δy)_i + τ_i − w_i`, so
+//! `|c_a − (M̃c_b + t̃)|_i <= e_a,i + Σ_j |M̃_ij| e_b,j + δ_a + m·δ_b + 3ε_M·R_b + |τ| + |w|`.
+//! The `f32` evaluation (3 products, 4 sums and the subtraction for the distance; 3
+//! products and 3 sums for the radius; one sum adding `P`) moves each side by at most
+//! `γ(5)` of its absolute terms, `<= 6u·(R_a + m·R_b + T)`, plus `u·P`.
+//!
+//! **`B`'s axes.** From `x = My + t + w`, `N(x − t − w) = NM·y = y + E·y`, so
+//! `y = Nx − Nt − Nw − E·y`; `|Nw|_j <= m·|w|` and `|E·y|_j <= ‖E‖_F·√3·R_b`. The rest is
+//! the argument above with `A` and `B` exchanged (`ε_M` also bounds the rounding of `Ñ`);
+//! `t̃_B` adds the `f64` error of `N·t` (`<= 2^-50·m·T`) to its rounding.
+//!
+//! **The pad.** With `ε₆₄ = 2^-50·(m·R_b + T)` and `‖E‖_F` computed in `f64` plus its
+//! rounding (`9·2^-50·m²`):
+//!
+//! ```text
+//! P = (1 + 2^-20)·[ (1 + m)(δ_a + δ_b + ε₆₄ + d) + 3ε_M·(R_a + R_b) + 2(u + 2^-50·m)·T
+//!                   + 2^-148 + ‖E‖_F·√3·R_b + 12u·(1 + m)(R_a + R_b + T) ]
+//! ```
+//!
+//! It exceeds every term of both tests (the factor `1 + 2^-20` absorbs `u·P` and the `f64`
+//! rounding of `P` itself, which is rounded up to `f32`). No constant in it is tuned: each
+//! term is one step of the proof.
+//!
+//! **Overflow.** The proof assumes no `f32` operation overflows: every value in the tests is
+//! at most `(1 + m)(R_a + R_b + T) + P`. When `(1 + m)(R_a + R_b + T) >= 2^126`, `P` is
+//! `+inf` instead and no pair is culled (an infinite radius never separates; NaN never
+//! separates); the exact leaf test still decides. Found by the `tree` fuzz target.
+//!
+//! At the root the 9 cross axes `e_i × M_j` (`M_j` a column of `M`) are tested as well, in
+//! `f64` ([`Relative::roots_separated`]): on axis `L` separated when
+//! `|L·D| > Σ|L_k| e_a,k + Σ|(MᵀL)_k| e_b,k + ‖L‖₁·(P + 2^-46(1 + m)(R_a + R_b + T))`,
+//! `D = M c_b + t − c_a`: the exact projection identity `L·(My + t + w − x) = 0` bounds `L·D`
+//! by the radii plus `‖L‖₁·(δ_a + m·δ_b + |w|) <= ‖L‖₁·P`, and the `f64` evaluation errs by
+//! far less than the second term.
+
+use glam::{DMat3, DVec3, Quat, Vec3A};
+
+use crate::transform::{Rigid3, Similarity3};
+
+const U: f64 = 1.0 / 16_777_216.0; // 2^-24
+
+/// `R(q)` in `f64`, the crate's formula on `q` as stored.
+fn rotation(q: Quat) -> DMat3 {
+    let [x, y, z, w] = q.to_array().map(f64::from);
+    let (x2, y2, z2) = (x + x, y + y, z + z);
+    let (xx, yy, zz) = (x * x2, y * y2, z * z2);
+    let (xy, xz, yz) = (x * y2, x * z2, y * z2);
+    let (wx, wy, wz) = (w * x2, w * y2, w * z2);
+    DMat3::from_cols(
+        DVec3::new(1.0 - (yy + zz), xy + wz, xz - wy),
+        DVec3::new(xy - wz, 1.0 - (xx + zz), yz + wx),
+        DVec3::new(xz + wy, yz - wx, 1.0 - (xx + yy)),
+    )
+}
+
+/// `B`'s frame in `A`'s frame for one query: `M`, `t`, their `f32` copies and the pad.
+#[derive(Clone, Copy, Debug)]
+pub struct Relative {
+    m: DMat3,
+    n: DMat3,
+    t: DVec3,
+    cols: [Vec3A; 3],
+    abs_cols: [Vec3A; 3],
+    rows: [Vec3A; 3],
+    abs_rows: [Vec3A; 3],
+    t32: Vec3A,
+    t_b: Vec3A,
+    pad: f32,
+    valid: bool,
+}
+
+impl Relative {
+    /// The relative pose of `B` (at `pb`, every box within `reach_b` of its origin on every
+    /// axis) in `A`'s frame (at `pa`, `reach_a`), with tolerance `tolerance` (pairs closer
+    /// than it count as overlapping). A non-finite pose, reach or tolerance, or a negative
+    /// one, gives a relative pose that places nothing ([`Relative::is_valid`] is false).
+    #[must_use]
+    pub fn new(pa: &Rigid3, reach_a: f32, pb: &Rigid3, reach_b: f32, tolerance: f32) -> Self {
+        Self::similarity(&(*pa).into(), reach_a, &(*pb).into(), reach_b, tolerance)
+    }
+
+    /// The same for poses with a uniform scale: `M = (σb/σa)·R(qa)ᵀ·R(qb)`,
+    /// `t = R(qa)ᵀ·(tb − ta)/σa`, and `B`'s axes tested through `N = (σa/σb)²·Mᵀ` (the
+    /// inverse of `M` for unit quaternions; for [`Rigid3`], `σ = 1` and `N = Mᵀ`). A zero
+    /// scale places nothing.
+    #[must_use]
+    pub fn similarity(
+        pa: &Similarity3,
+        reach_a: f32,
+        pb: &Similarity3,
+        reach_b: f32,
+        tolerance: f32,
+    ) -> Self {
+        let (sa, sb) = (f64::from(pa.scale), f64::from(pb.scale));
+        let ra_t = rotation(pa.rotation).transpose();
+        let m = ra_t * rotation(pb.rotation) * (sb / sa);
+        let t = ra_t * (pb.translation.as_dvec3() - pa.translation.as_dvec3()) / sa;
+        let n = if sa == sb {
+            m.transpose()
+        } else {
+            m.transpose() * ((sa / sb) * (sa / sb))
+        };
+        let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.as_vec3a());
+        // The columns of N (for a rotation, the rows of M).
+        let rows = [n.x_axis, n.y_axis, n.z_axis].map(|c| c.as_vec3a());
+        let t_b = -(n * t);
+        let finite = m.is_finite()
+            && n.is_finite()
+            && t.is_finite()
+            && reach_a.is_finite()
+            && reach_b.is_finite()
+            && tolerance.is_finite()
+            && reach_a >= 0.0
+            && reach_b >= 0.0
+            && tolerance >= 0.0;
+        let pad = if finite {
+            pad(&m, &n, t, t_b, reach_a, reach_b, tolerance)
+        } else {
+            f32::NAN
+        };
+        Relative {
+            m,
+            n,
+            t,
+            cols,
+            abs_cols: cols.map(Vec3A::abs),
+            rows,
+            abs_rows: rows.map(Vec3A::abs),
+            t32: t.as_vec3a(),
+            t_b: t_b.as_vec3a(),
+            pad,
+            valid: finite,
+        }
+    }
+
+    /// False when an input was NaN, infinite or negative: such a query reports nothing.
+    #[inline]
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        self.valid
+    }
+
+    /// `M = R(qa)ᵀ·R(qb)` in `f64`.
+    #[inline]
+    #[must_use]
+    pub fn matrix(&self) -> DMat3 {
+        self.m
+    }
+
+    /// `t = R(qa)ᵀ·(tb − ta)` in `f64`.
+    #[inline]
+    #[must_use]
+    pub fn translation(&self) -> DVec3 {
+        self.t
+    }
+
+    /// The pad `P` of the node-pair test (see the module docs).
+    #[inline]
+    #[must_use]
+    pub fn pad(&self) -> f32 {
+        self.pad
+    }
+
+    /// A point of `B`'s frame placed in `A`'s frame, `M·v + t` in `f64`.
+    #[inline]
+    #[must_use]
+    pub fn place(&self, v: glam::Vec3) -> DVec3 {
+        self.m * v.as_dvec3() + self.t
+    }
+
+    /// The 6-axis test on `center ± extent` boxes: false only when the boxes, placed by
+    /// this pose, are proven apart by more than the tolerance. NaN anywhere (an overflowed
+    /// box) never separates.
+    #[inline(always)]
+    pub(crate) fn overlaps_ce(&self, ca: Vec3A, ea: Vec3A, cb: Vec3A, eb: Vec3A) -> bool {
+        let [c0, c1, c2] = self.cols;
+        let [a0, a1, a2] = self.abs_cols;
+        let pad = Vec3A::splat(self.pad);
+        let d = (c0 * cb.x + c1 * cb.y + c2 * cb.z + self.t32 - ca).abs();
+        let r = a0 * eb.x + a1 * eb.y + a2 * eb.z + ea + pad;
+        if d.cmpgt(r).any() {
+            return false;
+        }
+        let [r0, r1, r2] = self.rows;
+        let [b0, b1, b2] = self.abs_rows;
+        let d = (r0 * ca.x + r1 * ca.y + r2 * ca.z + self.t_b - cb).abs();
+        let r = b0 * ea.x + b1 * ea.y + b2 * ea.z + eb + pad;
+        !d.cmpgt(r).any()
+    }
+
+    /// The same test on `min`/`max` boxes (`a` in `A`'s frame, `b` in `B`'s), read back as
+    /// center and extent with the rounding the pad covers; for the reaches given to
+    /// [`Relative::new`]. An empty box never overlaps; NaN faces always do (conservative).
+    #[must_use]
+    pub fn overlaps(&self, a: &crate::Aabb3, b: &crate::Aabb3) -> bool {
+        if !self.valid || a.min.cmpgt(a.max).any() || b.min.cmpgt(b.max).any() {
+            return false;
+        }
+        self.overlaps_ce(a.center(), a.half_extents(), b.center(), b.half_extents())
+    }
+
+    /// The 9 cross axes `e_i × M_j` in `f64` on two `center ± extent` boxes (the roots):
+    /// true when one of them proves the boxes apart (see the module docs).
+    pub(crate) fn roots_separated(
+        &self,
+        ca: Vec3A,
+        ea: Vec3A,
+        cb: Vec3A,
+        eb: Vec3A,
+        margin: f64,
+    ) -> bool {
+        let (ca, ea, cb, eb) = (ca.as_dvec3(), ea.as_dvec3(), cb.as_dvec3(), eb.as_dvec3());
+        let d = self.m * cb + self.t - ca;
+        let mt = self.m.transpose();
+        let cols = [self.m.x_axis, self.m.y_axis, self.m.z_axis];
+        for i in 0..3 {
+            let axis = DVec3::AXES[i];
+            for col in cols {
+                let l = axis.cross(col);
+                let norm = l.abs().element_sum();
+                let radius = l.abs().dot(ea)
+                    + (mt * l).abs().dot(eb)
+                    + norm * (f64::from(self.pad) + margin);
+                // Not `>`-negated: NaN never separates.
+                if l.dot(d).abs() > radius {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// The `f64` margin of the root cross-axis test: `2^-46·(1 + m)(R_a + R_b + T)`.
+    pub(crate) fn cross_margin(&self, reach_a: f32, reach_b: f32) -> f64 {
+        let (m, t) = norms(&self.m, &self.n, self.t, self.t_b.as_dvec3());
+        2f64.powi(-46) * (1.0 + m) * (f64::from(reach_a) + f64::from(reach_b) + t)
+    }
+}
+
+/// `m` (largest row or column sum of `|M|` or `|N|`) and `T` (largest `|t_i|` or `|t_B,i|`).
+fn norms(m: &DMat3, n: &DMat3, t: DVec3, t_b: DVec3) -> (f64, f64) {
+    let sums = |m: &DMat3| {
+        let abs = DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let cols = [abs.x_axis, abs.y_axis, abs.z_axis].map(DVec3::element_sum);
+        let rows = (0..3).map(|i| abs.row(i).element_sum());
+        rows.chain(cols).fold(0.0, f64::max)
+    };
+    let m = sums(m).max(sums(n)) * (1.0 + 2f64.powi(-40));
+    let t = t.abs().max_element().max(t_b.abs().max_element()) * (1.0 + 2f64.powi(-40));
+    (m, t)
+}
+
+/// The pad `P` of the module docs, rounded up to `f32`.
+fn pad(
+    m: &DMat3,
+    n: &DMat3,
+    t: DVec3,
+    t_b: DVec3,
+    reach_a: f32,
+    reach_b: f32,
+    tolerance: f32,
+) -> f32 {
+    let (mm, tt) = norms(m, n, t, t_b);
+    let grow = 1.0 + 2f64.powi(-18);
+    let (ra, rb) = (f64::from(reach_a) * grow, f64::from(reach_b) * grow);
+    let tiny = 2f64.powi(-148);
+    let (delta_a, delta_b) = (2.0 * U * ra + tiny, 2.0 * U * rb + tiny);
+    let max_entry = [m.x_axis, m.y_axis, m.z_axis, n.x_axis, n.y_axis, n.z_axis]
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0, f64::max);
+    let eps_m = U * max_entry + 2f64.powi(-150);
+    let eps_64 = 2f64.powi(-50) * (mm * rb + tt);
+    // ‖NM − I‖_F computed in f64, plus its own rounding (γ₆₄(3)·m² per entry, 9 entries).
+    let e = *n * *m - DMat3::IDENTITY;
+    let frob = [e.x_axis, e.y_axis, e.z_axis]
+        .iter()
+        .map(|c| c.length_squared())
+        .sum::<f64>()
+        .sqrt()
+        + 9.0 * 2f64.powi(-50) * mm * mm;
+    // Past 2^126 the f32 sums of a node-pair test could overflow (an infinite distance
+    // against a finite radius would separate): no pair is culled there.
+    if (1.0 + mm) * (ra + rb + tt) >= 2f64.powi(126) {
+        return f32::INFINITY;
+    }
+    let sum = (1.0 + mm) * (delta_a + delta_b + eps_64 + f64::from(tolerance))
+        + 3.0 * eps_m * (ra + rb)
+        + 2.0 * (U + 2f64.powi(-50) * mm) * tt
+        + tiny
+        + frob * 3f64.sqrt() * rb
+        + 12.0 * U * (1.0 + mm) * (ra + rb + tt);
+    let p = sum * (1.0 + 2f64.powi(-20));
+    let p32 = p as f32;
+    if f64::from(p32) < p {
+        p32.next_up()
+    } else {
+        p32
+    }
+}

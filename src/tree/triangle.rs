@@ -1,0 +1,329 @@
+//! The leaf test: do two closed triangles in 3D share a point? Exact, on `f64` vertices.
+//!
+//! Every decision is the sign of Shewchuk's adaptive `orient3d` or `orient2d` (the `robust`
+//! crate), which is exact for `f64` inputs whose intermediate products neither overflow nor
+//! underflow (coordinates within about `2^±300` of each other; any `f32` mesh at a pose with
+//! a sane quaternion). Touching (a shared vertex, an edge on a face) counts as intersecting,
+//! and degenerate triangles (segments, points) are normal input.
+//!
+//! **Why edges suffice.** Two closed triangles intersect iff an edge of one meets the other
+//! triangle. Not coplanar: the intersection is an interval of the line where the planes
+//! meet, and its end points lie on edges. Coplanar: if neither boundary met the other
+//! triangle, a point of both interiors would force one triangle inside the other, whose
+//! boundary would then meet it. Degenerate: the triangle is the union of its edges.
+//!
+//! **Why projections suffice.** Coplanar figures intersect iff their projections on all
+//! three coordinate planes intersect: one of the three projections (along an axis the plane's
+//! normal, or the common line's direction, does not lie across) is injective on them.
+
+use glam::DVec3;
+use robust::{Coord, Coord3D, orient2d, orient3d};
+
+#[inline(always)]
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// The sign of `orient3d(a, b, c, d)`: `0` for coplanar (and, conservatively, for NaN).
+#[inline(always)]
+fn o3(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    sign(orient3d(c3(a), c3(b), c3(c), c3(d)))
+}
+
+#[inline(always)]
+fn sign(x: f64) -> i8 {
+    (x > 0.0) as i8 - (x < 0.0) as i8
+}
+
+/// A point projected on the coordinate plane that drops `axis`.
+#[inline(always)]
+fn project(p: DVec3, axis: usize) -> Coord<f64> {
+    let (x, y) = match axis {
+        0 => (p.y, p.z),
+        1 => (p.z, p.x),
+        _ => (p.x, p.y),
+    };
+    Coord { x, y }
+}
+
+#[inline(always)]
+fn o2(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>) -> i8 {
+    sign(orient2d(a, b, c))
+}
+
+/// `p` on the segment `[a, b]`, given that the three are collinear (exact comparisons).
+#[inline(always)]
+fn within(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> bool {
+    a.x.min(b.x) <= p.x && p.x <= a.x.max(b.x) && a.y.min(b.y) <= p.y && p.y <= a.y.max(b.y)
+}
+
+/// Closed segments in the plane (either may be a point).
+fn segments_2d(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> bool {
+    let (d1, d2) = (o2(a, b, p), o2(a, b, q));
+    let (d3, d4) = (o2(p, q, a), o2(p, q, b));
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    (d1 == 0 && within(a, b, p))
+        || (d2 == 0 && within(a, b, q))
+        || (d3 == 0 && within(p, q, a))
+        || (d4 == 0 && within(p, q, b))
+}
+
+/// A closed segment and a closed triangle in the plane (the triangle may be degenerate).
+fn segment_triangle_2d(
+    p: Coord<f64>,
+    q: Coord<f64>,
+    a: Coord<f64>,
+    b: Coord<f64>,
+    c: Coord<f64>,
+) -> bool {
+    let edges = segments_2d(p, q, a, b) || segments_2d(p, q, b, c) || segments_2d(p, q, c, a);
+    if edges || o2(a, b, c) == 0 {
+        return edges;
+    }
+    // A proper triangle that no edge crosses: the segment is inside iff an end point is.
+    let inside = |x: Coord<f64>| {
+        let s = [o2(a, b, x), o2(b, c, x), o2(c, a, x)];
+        !(s.contains(&1) && s.contains(&-1))
+    };
+    inside(p)
+}
+
+/// True when `a`, `b`, `c` lie on one line: `(b − a) × (c − a) = 0`, whose components are
+/// the orientations of the three projections.
+fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    (0..3).all(|k| o2(project(a, k), project(b, k), project(c, k)) == 0)
+}
+
+/// Closed segments in 3D: coplanar, and intersecting in all three projections.
+fn segments(p: DVec3, q: DVec3, a: DVec3, b: DVec3) -> bool {
+    o3(p, q, a, b) == 0
+        && (0..3).all(|k| segments_2d(project(p, k), project(q, k), project(a, k), project(b, k)))
+}
+
+/// A closed segment `[p, q]` and the closed triangle `abc` in 3D.
+fn segment_triangle(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
+    if collinear(a, b, c) {
+        return segments(p, q, a, b) || segments(p, q, b, c) || segments(p, q, c, a);
+    }
+    let (sp, sq) = (o3(a, b, c, p), o3(a, b, c, q));
+    if sp * sq > 0 {
+        return false; // both strictly on one side
+    }
+    if sp == 0 && sq == 0 {
+        return (0..3).all(|k| {
+            let pr = |x: DVec3| project(x, k);
+            segment_triangle_2d(pr(p), pr(q), pr(a), pr(b), pr(c))
+        });
+    }
+    // The line pq crosses the plane at one point, which the segment reaches; it lies in
+    // the closed triangle iff pq turns the same way (or not at all) around each edge.
+    let s = [o3(p, q, a, b), o3(p, q, b, c), o3(p, q, c, a)];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+/// The signs of `u`'s vertices against the plane of `t`, from `n·(p − t₀)` with
+/// `n = (t₁ − t₀) × (t₂ − t₀)` in `f64`, or `None` when one of them is not certain.
+///
+/// The filter: each of the six products `±e₁·e₂·w` of the determinant carries at most 9
+/// roundings (three differences, the cross product's products and difference, the dot
+/// product's products and sums), so the computed value errs by at most
+/// `γ(9)·perm < 2^-49.7·perm` with `perm` the sum of their absolute values; `perm` is itself
+/// computed with at most 6 roundings, so `2^-48·perm` bounds the error. A sign is certain when
+/// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
+/// products could underflow, or not finite) nothing is certain and the exact predicate
+/// decides.
+const TWO_POW_M48: f64 = f64::from_bits((1023 - 48) << 52);
+const TWO_POW_M900: f64 = f64::from_bits((1023 - 900) << 52);
+
+#[inline(always)]
+fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let n = e1.cross(e2);
+    let na = DVec3::new(
+        (e1.y * e2.z).abs() + (e1.z * e2.y).abs(),
+        (e1.z * e2.x).abs() + (e1.x * e2.z).abs(),
+        (e1.x * e2.y).abs() + (e1.y * e2.x).abs(),
+    );
+    let mut signs = [0i8; 3];
+    for (k, p) in u.iter().enumerate() {
+        let w = *p - t[0];
+        let value = n.dot(w);
+        let perm = na.dot(w.abs());
+        if !(TWO_POW_M900..f64::INFINITY).contains(&perm) {
+            return None;
+        }
+        let bound = perm * TWO_POW_M48;
+        if value > bound {
+            signs[k] = 1;
+        } else if value < -bound {
+            signs[k] = -1;
+        } else {
+            return None;
+        }
+    }
+    Some(signs)
+}
+
+/// The sign of `O(a, b, c, d) = ((b − a) × (c − a))·(d − a)`, exact (Shewchuk's `orient3d`
+/// is `−O`).
+#[inline(always)]
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    -o3(a, b, c, d)
+}
+
+/// The signs of `O(t₀, t₁, t₂, u_k)`: filtered, exact where the filter is unsure.
+#[inline(always)]
+fn signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> [i8; 3] {
+    plane_signs(t, u).unwrap_or_else(|| u.map(|p| orient(t[0], t[1], t[2], p)))
+}
+
+/// True when all three signs are the same and not zero.
+#[inline(always)]
+fn aside(s: [i8; 3]) -> bool {
+    s == [1, 1, 1] || s == [-1, -1, -1]
+}
+
+/// True when the closed triangles `a` and `b` share a point (exact; touching counts).
+#[must_use]
+pub fn triangles_intersect(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
+    // The common rejection first (a filtered, then exact, plane-side test): one triangle
+    // strictly on one side of the other's plane.
+    let sb = signs(a, b);
+    if aside(sb) {
+        return false;
+    }
+    let sa = signs(b, a);
+    if aside(sa) {
+        return false;
+    }
+    if !sa.contains(&0) && !sb.contains(&0) {
+        return crossing(a, b, sa, sb);
+    }
+    // Some vertex on the other plane, coplanar or degenerate: the edge tests.
+    let edges = [(0, 1), (1, 2), (2, 0)];
+    edges
+        .iter()
+        .any(|&(i, j)| segment_triangle(a[i], a[j], b[0], b[1], b[2]))
+        || edges
+            .iter()
+            .any(|&(i, j)| segment_triangle(b[i], b[j], a[0], a[1], a[2]))
+}
+
+/// Guigue and Devillers' test for triangles that each cross the other's plane strictly (no
+/// vertex on the other plane; `sa`, `sb` the signs of `a`'s vertices against `b`'s plane
+/// and of `b`'s against `a`'s, none zero).
+///
+/// Each triangle has one vertex alone on its side; rotating the vertices (which keeps the
+/// orientation) puts it first, as `p₁` and `p₂`, and swapping the other two of the other
+/// triangle puts `p₁` on the positive side of `π₂` and `p₂` on the positive side of `π₁`.
+/// The planes then cut `a` in `[i, j]` (`i` on `p₁q₁`, `j` on `p₁r₁`) and `b` in `[k, l]`,
+/// on the line where the planes meet, and the two intervals overlap iff `k` is not past `j`
+/// and `i` not past `l`, which are the signs of `O(p₁, q₁, p₂, q₂)` and
+/// `O(p₁, r₁, r₂, p₂)` (both `<= 0`); zero is touching, which counts. (The opposite sign
+/// convention fails the exact reference of `tests/trees.rs` at once.)
+fn crossing(a: &[DVec3; 3], b: &[DVec3; 3], sa: [i8; 3], sb: [i8; 3]) -> bool {
+    let lone = |s: [i8; 3]| {
+        if s[0] == s[1] {
+            2
+        } else if s[0] == s[2] {
+            1
+        } else {
+            0
+        }
+    };
+    let (i, j) = (lone(sa), lone(sb));
+    let (p1, mut q1, mut r1) = (a[i], a[(i + 1) % 3], a[(i + 2) % 3]);
+    let (p2, mut q2, mut r2) = (b[j], b[(j + 1) % 3], b[(j + 2) % 3]);
+    if sa[i] < 0 {
+        core::mem::swap(&mut q2, &mut r2);
+    }
+    if sb[j] < 0 {
+        core::mem::swap(&mut q1, &mut r1);
+    }
+    orient(p1, q1, p2, q2) <= 0 && orient(p1, r1, r2, p2) <= 0
+}
+
+/// The squared distance from `p` to the segment `[a, b]` (`f64`, not exact).
+fn point_segment_sq(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let len = ab.length_squared();
+    let s = if len > 0.0 {
+        ((p - a).dot(ab) / len).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * s - p).length_squared()
+}
+
+/// The squared distance between segments `[p, q]` and `[a, b]` (`f64`, not exact).
+fn segment_segment_sq(p: DVec3, q: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ends = point_segment_sq(p, a, b)
+        .min(point_segment_sq(q, a, b))
+        .min(point_segment_sq(a, p, q))
+        .min(point_segment_sq(b, p, q));
+    // The interior minimum, where it exists (the end points cover every other case).
+    let (d1, d2, r) = (q - p, b - a, p - a);
+    let (aa, ee, bb) = (d1.length_squared(), d2.length_squared(), d1.dot(d2));
+    let denom = aa * ee - bb * bb;
+    if denom > 0.0 {
+        let (c, f) = (d1.dot(r), d2.dot(r));
+        let s = (bb * f - c * ee) / denom;
+        let t = (aa * f - bb * c) / denom;
+        if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t) {
+            return ends.min((p + d1 * s - (a + d2 * t)).length_squared());
+        }
+    }
+    ends
+}
+
+/// The squared distance from `p` to the triangle `abc` (`f64`, not exact).
+fn point_triangle_sq(p: DVec3, t: &[DVec3; 3]) -> f64 {
+    let edges = point_segment_sq(p, t[0], t[1])
+        .min(point_segment_sq(p, t[1], t[2]))
+        .min(point_segment_sq(p, t[2], t[0]));
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let nn = n.length_squared();
+    if nn > 0.0 {
+        let h = (p - t[0]).dot(n);
+        let foot = p - n * (h / nn);
+        let inside = (0..3).all(|i| {
+            let (u, v) = (t[i], t[(i + 1) % 3]);
+            (v - u).cross(foot - u).dot(n) >= 0.0
+        });
+        if inside {
+            return edges.min(h * h / nn);
+        }
+    }
+    edges
+}
+
+/// The squared distance between two triangles in `f64`: zero when they intersect (decided
+/// exactly), otherwise the least of the 9 edge–edge and 6 vertex–triangle distances, each
+/// rounded (relative error a few `2^-52`).
+#[must_use]
+pub fn triangles_distance_sq(a: &[DVec3; 3], b: &[DVec3; 3]) -> f64 {
+    if triangles_intersect(a, b) {
+        return 0.0;
+    }
+    let mut best = f64::INFINITY;
+    for i in 0..3 {
+        best = best
+            .min(point_triangle_sq(a[i], b))
+            .min(point_triangle_sq(b[i], a));
+        for j in 0..3 {
+            best = best.min(segment_segment_sq(
+                a[i],
+                a[(i + 1) % 3],
+                b[j],
+                b[(j + 1) % 3],
+            ));
+        }
+    }
+    best
+}

@@ -1,0 +1,697 @@
+//! Local-frame AABB trees against exact references:
+//! - the node-pair box test against an exact rational separating-axis test (zero false
+//!   "separated" verdicts over the adversarial classes);
+//! - `overlapping_triangles` and `intersects` against a brute-force all-pairs test;
+//! - the triangle test against an exact separating-axis reference;
+//! - errors, refit, layouts and their sizes.
+
+mod sat;
+mod trimesh;
+
+use std::ops::ControlFlow;
+
+use bvkit::tree::{
+    AabbTree, Compact, MeshError, Quantized, Query, Relative, TriMesh, triangles_distance_sq,
+    triangles_intersect,
+};
+use bvkit::{Aabb3, Rigid3, Similarity3};
+use glam::{DVec3, Quat, Vec3, Vec3A};
+use sat::{exact_overlap, exact_triangles};
+use trimesh::Uniform;
+
+fn reach(boxes: &[Aabb3]) -> f32 {
+    boxes
+        .iter()
+        .map(|b| b.min.abs().max(b.max.abs()).max_element())
+        .fold(0.0, f32::max)
+}
+
+fn aabb(c: Vec3, h: Vec3) -> Aabb3 {
+    Aabb3::new((c - h).into(), (c + h).into())
+}
+
+/// One adversarial case: `(a, b, pa, pb)`.
+type Case = (Aabb3, Aabb3, Rigid3, Rigid3);
+
+/// A box `b` and a pose, then `a` placed to just touch (or just miss) `b`'s exact image on
+/// one axis of A: its face is the f64 extreme of the image, rounded to f32 either way.
+fn near_contact(g: &mut Uniform, b: Aabb3, pa: Rigid3, pb: Rigid3, size: f32) -> Aabb3 {
+    let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0);
+    let corners: Vec<DVec3> = (0..8)
+        .map(|k| {
+            let p = Vec3::new(
+                if k & 1 == 0 { b.min.x } else { b.max.x },
+                if k & 2 == 0 { b.min.y } else { b.max.y },
+                if k & 4 == 0 { b.min.z } else { b.max.z },
+            );
+            rel.place(p)
+        })
+        .collect();
+    let axis = (g.next() * 3.0) as usize % 3;
+    let upper = g.next() < 0.5;
+    let mid: DVec3 = corners.iter().copied().sum::<DVec3>() / 8.0;
+    let extreme = if upper {
+        corners.iter().map(|c| c[axis]).fold(f64::MIN, f64::max)
+    } else {
+        corners.iter().map(|c| c[axis]).fold(f64::MAX, f64::min)
+    };
+    let mut face = extreme as f32;
+    match (g.next() * 3.0) as u32 {
+        0 => face = face.next_up(),
+        1 => face = face.next_down(),
+        _ => {}
+    }
+    let mut lo = mid.as_vec3() - Vec3::splat(size);
+    let mut hi = mid.as_vec3() + Vec3::splat(size);
+    // a sits beyond the face: its near face at `face`.
+    if upper {
+        lo[axis] = face;
+        hi[axis] = face + size;
+    } else {
+        hi[axis] = face;
+        lo[axis] = face - size;
+    }
+    Aabb3::new(lo.into(), hi.into())
+}
+
+fn adversarial_cases() -> Vec<(&'static str, Case)> {
+    let mut g = Uniform(0x5eed_b0c5);
+    let mut cases = Vec::new();
+    let classes: [&str; 9] = [
+        "generic",
+        "far from origin",
+        "thin and zero-width",
+        "quarter turns (parallel edges)",
+        "near identity",
+        "touching faces (identity)",
+        "huge scale",
+        "tiny scale",
+        "non-unit quaternions",
+    ];
+    for (ci, &class) in classes.iter().enumerate() {
+        for _ in 0..220 {
+            let scale: f32 = match class {
+                "huge scale" => 1e30,
+                "tiny scale" => 1e-30,
+                _ => 1.0,
+            };
+            let offset = if class == "far from origin" {
+                Vec3::new(3.0e5, -7.0e5, 1.1e6)
+            } else {
+                Vec3::ZERO
+            };
+            let mut size = Vec3::new(g.range(0.01, 2.0), g.range(0.01, 2.0), g.range(0.01, 2.0));
+            if class == "thin and zero-width" {
+                let k = (g.next() * 3.0) as usize % 3;
+                size[k] = if g.next() < 0.5 { 0.0 } else { 1e-7 };
+                if g.next() < 0.3 {
+                    size[(k + 1) % 3] = 0.0;
+                }
+            }
+            let rot = |g: &mut Uniform| -> Quat {
+                match class {
+                    "quarter turns (parallel edges)" => {
+                        let k = (g.next() * 24.0) as i32;
+                        Quat::from_euler(
+                            glam::EulerRot::XYZ,
+                            (k % 4) as f32 * std::f32::consts::FRAC_PI_2,
+                            ((k / 4) % 3) as f32 * std::f32::consts::FRAC_PI_2,
+                            ((k / 12) % 2) as f32 * std::f32::consts::PI,
+                        )
+                    }
+                    "near identity" => Quat::from_xyzw(
+                        g.range(-1e-7, 1e-7),
+                        g.range(-1e-7, 1e-7),
+                        g.range(-1e-7, 1e-7),
+                        1.0,
+                    ),
+                    "touching faces (identity)" => Quat::IDENTITY,
+                    "non-unit quaternions" => {
+                        let q = g.rotation();
+                        q * g.range(0.999, 1.001)
+                    }
+                    _ => g.rotation(),
+                }
+            };
+            let (qa, qb) = (rot(&mut g), rot(&mut g));
+            let ta = offset * scale
+                + Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)) * scale;
+            let tb =
+                ta + Vec3::new(g.range(-2.0, 2.0), g.range(-2.0, 2.0), g.range(-2.0, 2.0)) * scale;
+            let (pa, pb) = (Rigid3::new(qa, ta.into()), Rigid3::new(qb, tb.into()));
+            let cb = offset * scale * 0.0
+                + Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)) * scale;
+            let b = aabb(cb, size * scale);
+            let a = if ci % 2 == 0 || class == "touching faces (identity)" || g.next() < 0.5 {
+                near_contact(&mut g, b, pa, pb, 0.5 * scale)
+            } else {
+                let ca =
+                    Vec3::new(g.range(-2.0, 2.0), g.range(-2.0, 2.0), g.range(-2.0, 2.0)) * scale;
+                aabb(
+                    ca,
+                    Vec3::new(g.range(0.0, 1.0), g.range(0.0, 1.0), g.range(0.0, 1.0)) * scale,
+                )
+            };
+            cases.push((class, (a, b, pa, pb)));
+        }
+    }
+    cases
+}
+
+#[test]
+fn box_pair_test_never_separates_overlapping_boxes() {
+    let mut overlapping = 0;
+    let mut separated_found = 0;
+    let mut separated_total = 0;
+    for (class, (a, b, pa, pb)) in adversarial_cases() {
+        let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+        assert!(rel.is_valid());
+        let exact = exact_overlap(&a, &b, rel.matrix(), rel.translation());
+        let ours = rel.overlaps(&a, &b);
+        assert!(
+            ours || !exact,
+            "{class}: exact boxes overlap but reported separated: {a:?} {b:?} {pa:?} {pb:?}"
+        );
+        if exact {
+            overlapping += 1;
+        } else {
+            separated_total += 1;
+            separated_found += !ours as u32;
+        }
+    }
+    // Not vacuous: both verdicts occur, and most separations are seen by 6 axes + pad.
+    assert!(overlapping > 300, "{overlapping}");
+    assert!(separated_total > 300, "{separated_total}");
+    assert!(
+        separated_found * 3 > separated_total,
+        "{separated_found}/{separated_total}"
+    );
+}
+
+#[test]
+fn box_tree_leaf_pairs_contain_every_exact_overlap() {
+    let mut g = Uniform(77);
+    let boxes = |g: &mut Uniform, n: usize| -> Vec<Aabb3> {
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(g.range(-3.0, 3.0), g.range(-3.0, 3.0), g.range(-3.0, 3.0));
+                let mut h = Vec3::new(g.range(0.0, 0.4), g.range(0.0, 0.4), g.range(0.0, 0.4));
+                if g.next() < 0.2 {
+                    h.x = 0.0;
+                }
+                aabb(c, h)
+            })
+            .collect()
+    };
+    for round in 0..6 {
+        let (ba, bb) = (boxes(&mut g, 40), boxes(&mut g, 30));
+        let (pa, pb) = (
+            trimesh::poses(1, 1.0, round)[0],
+            trimesh::poses(1, 1.0, round + 99)[0],
+        );
+        let (ta, tb) = (AabbTree::new(&ba).unwrap(), AabbTree::new(&bb).unwrap());
+        let (qa, qb) = (
+            AabbTree::<Quantized>::build(&ba).unwrap(),
+            AabbTree::<Quantized>::build(&bb).unwrap(),
+        );
+        let pairs = ta.query(pa, &tb, pb).leaf_pairs();
+        let qpairs = qa.query(pa, &qb, pb).leaf_pairs();
+        let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0);
+        let mut exact_count = 0;
+        for (i, a) in ba.iter().enumerate() {
+            for (j, b) in bb.iter().enumerate() {
+                if exact_overlap(a, b, rel.matrix(), rel.translation()) {
+                    exact_count += 1;
+                    let p = (i as u32, j as u32);
+                    assert!(pairs.contains(&p), "compact tree culled {p:?}");
+                    assert!(qpairs.contains(&p), "quantized tree culled {p:?}");
+                }
+            }
+        }
+        assert!(exact_count > 0);
+        // Conservative but tight: the tree reports each pair once, and only pairs whose
+        // boxes pass the per-pair test.
+        let mut sorted = pairs.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), pairs.len());
+        let rel = ta.query(pa, &tb, pb).relative().to_owned();
+        for &(i, j) in &pairs {
+            assert!(rel.overlaps(&ba[i as usize], &bb[j as usize]));
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Triangles.
+
+fn random_triangle(g: &mut Uniform, spread: f64) -> [DVec3; 3] {
+    core::array::from_fn(|_| {
+        DVec3::new(
+            f64::from(g.range(-spread, spread)),
+            f64::from(g.range(-spread, spread)),
+            f64::from(g.range(-spread, spread)),
+        )
+    })
+}
+
+#[test]
+fn triangle_test_matches_exact_reference() {
+    let mut g = Uniform(4242);
+    let mut hits = 0;
+    for k in 0..2500 {
+        let a = random_triangle(&mut g, 1.0);
+        let mut b = random_triangle(&mut g, 1.0);
+        match k % 5 {
+            // touching: a vertex of b on an edge or at a vertex of a (exact midpoint)
+            1 => b[0] = a[0],
+            2 => b[1] = (a[0] + a[1]) * 0.5,
+            // coplanar: b in a's plane (an exact affine combination on a dyadic grid)
+            3 => {
+                for p in &mut b {
+                    let (s, t) = (f64::from(g.range(-1.0, 2.0)), f64::from(g.range(-1.0, 2.0)));
+                    let (s, t) = ((s * 8.0).round() / 8.0, (t * 8.0).round() / 8.0);
+                    *p = a[0] + (a[1] - a[0]) * s + (a[2] - a[0]) * t;
+                }
+            }
+            // quarter-turned copy sharing an edge
+            4 => b = [a[0], a[1], DVec3::new(a[2].y, -a[2].x, a[2].z)],
+            _ => {}
+        }
+        let degenerate = |t: &[DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]) == DVec3::ZERO;
+        if degenerate(&a) || degenerate(&b) {
+            continue;
+        }
+        let exact = exact_triangles(&a, &b);
+        assert_eq!(triangles_intersect(&a, &b), exact, "{a:?} {b:?}");
+        assert_eq!(triangles_intersect(&b, &a), exact, "{b:?} {a:?}");
+        hits += exact as u32;
+    }
+    assert!(hits > 300, "{hits}");
+}
+
+#[test]
+fn degenerate_triangles() {
+    let d = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let tri = [d(0.0, 0.0, 0.0), d(2.0, 0.0, 0.0), d(0.0, 2.0, 0.0)];
+    // A segment through the face, touching it, and beside it.
+    let through = [d(0.5, 0.5, -1.0), d(0.5, 0.5, 1.0), d(0.5, 0.5, 1.0)];
+    let touching = [d(1.0, 1.0, 0.0), d(1.0, 1.0, 3.0), d(1.0, 1.0, 3.0)];
+    let beside = [d(1.01, 1.0, -1.0), d(1.01, 1.0, 1.0), d(1.01, 1.0, 0.5)];
+    assert!(triangles_intersect(&tri, &through));
+    assert!(triangles_intersect(&tri, &touching));
+    assert!(!triangles_intersect(&tri, &beside));
+    // A point on an edge, a point just off it, collinear segments overlapping or not.
+    let on_edge = [d(1.0, 0.0, 0.0); 3];
+    let off_edge = [d(1.0, -1e-300, 0.0); 3];
+    assert!(triangles_intersect(&tri, &on_edge));
+    assert!(!triangles_intersect(&tri, &off_edge));
+    let s1 = [d(0.0, 0.0, 5.0), d(1.0, 1.0, 5.0), d(2.0, 2.0, 5.0)];
+    let s2 = [d(2.0, 2.0, 5.0), d(3.0, 3.0, 5.0), d(3.0, 3.0, 5.0)];
+    let s3 = [d(2.5, 2.5, 5.0), d(3.0, 3.0, 5.0), d(3.0, 3.0, 5.0)];
+    assert!(triangles_intersect(&s1, &s2));
+    assert!(!triangles_intersect(&s1, &s3));
+    assert!(triangles_intersect(
+        &[d(1.0, 1.0, 1.0); 3],
+        &[d(1.0, 1.0, 1.0); 3]
+    ));
+    assert!(!triangles_intersect(
+        &[d(1.0, 1.0, 1.0); 3],
+        &[d(1.0, 1.0, 1.0 + 1e-15); 3]
+    ));
+    // Distances.
+    assert_eq!(triangles_distance_sq(&tri, &through), 0.0);
+    let lifted = tri.map(|p| p + d(0.0, 0.0, 0.5));
+    assert!((triangles_distance_sq(&tri, &lifted) - 0.25).abs() < 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------
+// Meshes against brute force.
+
+fn brute_force<L, M>(
+    a: &TriMesh<L>,
+    b: &TriMesh<M>,
+    rel: &Relative,
+    tolerance: f32,
+) -> Vec<(u32, u32)>
+where
+    L: bvkit::tree::Layout,
+    M: bvkit::tree::Layout,
+{
+    let mut pairs = Vec::new();
+    for i in 0..a.triangles().len() as u32 {
+        let ta = a.triangle(i).unwrap().map(|v| v.as_dvec3());
+        for j in 0..b.triangles().len() as u32 {
+            let tb = b.triangle(j).unwrap().map(|v| rel.place(v));
+            let meet = if tolerance > 0.0 {
+                triangles_distance_sq(&ta, &tb) <= f64::from(tolerance).powi(2)
+            } else {
+                triangles_intersect(&ta, &tb)
+            };
+            if meet {
+                pairs.push((i, j));
+            }
+        }
+    }
+    pairs
+}
+
+/// A named mesh: vertices and triangles.
+type Named = (&'static str, Vec<Vec3>, Vec<[u32; 3]>);
+
+fn small_meshes() -> Vec<Named> {
+    let (tv, tt) = trimesh::torus(1.0, 0.35, 10, 6);
+    let cube_v: Vec<Vec3> = (0..8)
+        .map(|k| Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32) - 0.5)
+        .collect();
+    let cube_t = vec![
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ];
+    // A fan with a degenerate triangle and a repeated one.
+    let fan_v = vec![
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::Y,
+        Vec3::new(2.0, 0.0, 0.0),
+        Vec3::Z,
+    ];
+    let fan_t = vec![[0, 1, 2], [0, 1, 3], [0, 2, 4], [0, 1, 2], [1, 4, 2]];
+    vec![
+        ("torus", tv, tt),
+        ("cube", cube_v, cube_t),
+        ("fan", fan_v, fan_t),
+    ]
+}
+
+#[test]
+fn overlapping_triangles_equal_brute_force() {
+    let meshes = small_meshes();
+    let mut total_pairs = 0;
+    let mut any_disjoint = false;
+    for (na, va, ia) in &meshes {
+        let a = TriMesh::new(va.clone(), ia.clone()).unwrap();
+        let aq = a.with_layout::<Quantized>();
+        for (nb, vb, ib) in &meshes {
+            let b = TriMesh::new(vb.clone(), ib.clone()).unwrap();
+            let bq = b.with_layout::<Quantized>();
+            for (k, (pa, pb)) in trimesh::poses(12, 0.8, 1)
+                .into_iter()
+                .zip(trimesh::poses(12, 0.8, 2))
+                .enumerate()
+            {
+                // Some exact touching poses too: identity and quarter turns.
+                let pb = if k % 4 == 0 {
+                    Rigid3::new(
+                        Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
+                        Vec3A::ZERO,
+                    )
+                } else {
+                    pb
+                };
+                let tolerance = if k % 3 == 2 { 0.05 } else { 0.0 };
+                let q = Query::new(&a, pa, &b, pb).with_tolerance(tolerance);
+                let mut ours = q.overlapping_triangles();
+                ours.sort_unstable();
+                let expected = brute_force(&a, &b, q.relative(), tolerance);
+                assert_eq!(ours, expected, "{na} vs {nb}, pose {k}");
+                assert_eq!(
+                    q.intersects(),
+                    !expected.is_empty(),
+                    "{na} vs {nb}, pose {k}"
+                );
+                let mut quant = Query::new(&aq, pa, &bq, pb)
+                    .with_tolerance(tolerance)
+                    .overlapping_triangles();
+                quant.sort_unstable();
+                assert_eq!(quant, expected, "quantized {na} vs {nb}, pose {k}");
+                let mut cross = q.with_cross_axes_near_leaves(true).overlapping_triangles();
+                cross.sort_unstable();
+                assert_eq!(cross, expected, "cross axes {na} vs {nb}, pose {k}");
+                total_pairs += expected.len();
+                any_disjoint |= expected.is_empty();
+            }
+        }
+    }
+    assert!(total_pairs > 100 && any_disjoint, "{total_pairs}");
+}
+
+#[test]
+fn visitor_stops_early() {
+    let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
+    let a = TriMesh::new(v, t).unwrap();
+    let q = a.query(
+        Rigid3::IDENTITY,
+        &a,
+        Rigid3::new(Quat::from_rotation_x(0.3), Vec3A::ZERO),
+    );
+    let all = q.overlapping_triangles();
+    assert!(all.len() > 3);
+    let mut seen = 0;
+    let (flow, _) = q.visit(|_, _| {
+        seen += 1;
+        if seen == 3 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    assert!(flow.is_break());
+    assert_eq!(seen, 3);
+}
+
+// ---------------------------------------------------------------------------------------
+// Layouts, errors, refit.
+
+#[test]
+fn layouts_fit_their_budgets() {
+    let (v, t) = trimesh::torus(1.0, 0.3, 40, 25);
+    let n = t.len();
+    let a = TriMesh::new(v, t).unwrap();
+    assert!(a.tree_bytes() <= 32 * n, "{}", a.tree_bytes());
+    let q = a.with_layout::<Quantized>();
+    assert!(q.tree_bytes() <= 20 * n, "{}", q.tree_bytes());
+    assert_eq!(a.tree_bytes() / 32, n - 1);
+    // Deterministic: the same input builds the same tree.
+    let b = TriMesh::new(a.vertices().to_vec(), a.triangles().to_vec()).unwrap();
+    let pose = trimesh::poses(1, 0.5, 9)[0];
+    assert_eq!(
+        a.query(Rigid3::IDENTITY, &a, pose)
+            .visit_boxes(|_, _| ControlFlow::Continue(()))
+            .1,
+        b.query(Rigid3::IDENTITY, &b, pose)
+            .visit_boxes(|_, _| ControlFlow::Continue(()))
+            .1
+    );
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let v = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+    assert_eq!(
+        TriMesh::new(v.clone(), vec![]).unwrap_err(),
+        MeshError::Empty
+    );
+    assert!(matches!(
+        TriMesh::new(v.clone(), vec![[0, 1, 3]]),
+        Err(MeshError::IndexOutOfRange {
+            triangle: 0,
+            index: 3,
+            vertices: 3
+        })
+    ));
+    let mut bad = v.clone();
+    bad[1].y = f32::NAN;
+    assert!(matches!(
+        TriMesh::new(bad.clone(), vec![[0, 1, 2]]),
+        Err(MeshError::NonFiniteVertex { vertex: 1, .. })
+    ));
+    let mut mesh = TriMesh::new(v.clone(), vec![[0, 1, 2]]).unwrap();
+    assert!(mesh.refit(&bad).is_err());
+    assert!(mesh.refit(&v[..2]).is_err());
+    assert!(AabbTree::new(&[]).is_err());
+    assert!(AabbTree::new(&[Aabb3::new(Vec3A::ONE, Vec3A::ZERO)]).is_err());
+    assert!(AabbTree::new(&[Aabb3::new(Vec3A::ZERO, Vec3A::INFINITY)]).is_err());
+    // Non-finite poses and tolerances: no panic, nothing reported.
+    let nan = Rigid3::new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3A::ZERO);
+    assert!(!mesh.intersects(nan, &mesh, Rigid3::IDENTITY));
+    assert!(
+        mesh.query(Rigid3::IDENTITY, &mesh, Rigid3::IDENTITY)
+            .with_tolerance(f32::NAN)
+            .overlapping_triangles()
+            .is_empty()
+    );
+    // One triangle against itself: touching everywhere.
+    assert_eq!(
+        mesh.overlapping_triangles(Rigid3::IDENTITY, &mesh, Rigid3::IDENTITY),
+        vec![(0, 0)]
+    );
+    // Extreme but finite geometry builds and queries without panicking.
+    let huge = vec![
+        Vec3::splat(-f32::MAX),
+        Vec3::splat(f32::MAX),
+        Vec3::new(f32::MAX, 0.0, -f32::MAX),
+    ];
+    let h = TriMesh::new(huge, vec![[0, 1, 2], [2, 1, 0]]).unwrap();
+    let hq = h.with_layout::<Quantized>();
+    assert_eq!(h.triangle(2), None);
+    let _ = h.overlapping_triangles(
+        Rigid3::IDENTITY,
+        &hq,
+        Rigid3::new(Quat::from_rotation_y(1.0), Vec3A::splat(1e38)),
+    );
+}
+
+#[test]
+fn refit_matches_a_fresh_build() {
+    let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
+    let mut a = TriMesh::new(v.clone(), t.clone()).unwrap();
+    let mut aq = a.with_layout::<Quantized>();
+    let moved: Vec<Vec3> = v
+        .iter()
+        .map(|p| *p * Vec3::new(1.3, 0.7, 1.0) + Vec3::new(0.1 * p.z.sin(), 0.0, 0.2))
+        .collect();
+    a.refit(&moved).unwrap();
+    aq.refit(&moved).unwrap();
+    let fresh = TriMesh::new(moved, t.clone()).unwrap();
+    let other = TriMesh::new(v, t).unwrap();
+    for pose in trimesh::poses(8, 0.7, 5) {
+        let mut x = a.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
+        let mut y = fresh.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
+        let mut z = aq.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
+        x.sort_unstable();
+        y.sort_unstable();
+        z.sort_unstable();
+        assert_eq!(x, y);
+        assert_eq!(z, y);
+    }
+    let _: &TriMesh<Compact> = &a;
+}
+
+#[test]
+fn similarity_poses() {
+    // Boxes: the adversarial cases with uniform scales on both poses.
+    let mut g = Uniform(31337);
+    let mut overlapping = 0;
+    for (class, (a, b, pa, pb)) in adversarial_cases().into_iter().step_by(3) {
+        let (sa, sb) = (g.range(0.25, 4.0), g.range(0.25, 4.0));
+        let (sa, sb) = if g.next() < 0.2 { (-sa, sb) } else { (sa, sb) };
+        let pa = Similarity3::new(sa, pa.rotation, pa.translation);
+        let pb = Similarity3::new(sb, pb.rotation, pb.translation);
+        let rel = Relative::similarity(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+        let exact = exact_overlap(&a, &b, rel.matrix(), rel.translation());
+        assert!(
+            rel.overlaps(&a, &b) || !exact,
+            "{class}: {a:?} {b:?} {pa:?} {pb:?}"
+        );
+        overlapping += exact as u32;
+    }
+    assert!(overlapping > 50, "{overlapping}");
+    // Meshes: brute force at scaled poses.
+    let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
+    let a = TriMesh::new(v.clone(), t.clone()).unwrap();
+    let b = TriMesh::new(v, t).unwrap().with_layout::<Quantized>();
+    let mut total = 0;
+    for (k, p) in trimesh::poses(10, 0.6, 21).into_iter().enumerate() {
+        let s = 0.5 + 0.2 * k as f32;
+        let pa = Similarity3::new(1.5, Quat::IDENTITY, Vec3A::ZERO);
+        let pb = Similarity3::new(s, p.rotation, p.translation);
+        let q = Query::similarity(&a, pa, &b, pb);
+        let mut ours = q.overlapping_triangles();
+        ours.sort_unstable();
+        let expected = brute_force(&a, &b, q.relative(), 0.0);
+        assert_eq!(ours, expected, "pose {k}");
+        total += expected.len();
+    }
+    assert!(total > 20, "{total}");
+    // A zero scale places nothing and does not panic.
+    let zero = Similarity3::new(0.0, Quat::IDENTITY, Vec3A::ZERO);
+    assert!(
+        Query::similarity(&a, zero, &b, Similarity3::IDENTITY)
+            .overlapping_triangles()
+            .is_empty()
+    );
+}
+
+#[test]
+fn sums_that_would_overflow_f32_never_separate() {
+    // Found by the `tree` fuzz target: the placed center overflows f32 while the exact
+    // boxes overlap just below f32::MAX.
+    let a = Aabb3::new(
+        Vec3A::new(-0.9887, -8.002_044_4e30, -0.8871),
+        Vec3A::splat(f32::MAX),
+    );
+    let b = Aabb3::new(
+        Vec3A::new(-0.7234, -2_097_152.0, 2.98e-43),
+        Vec3A::new(0.0, 1e30, 1.175_494_4e-38),
+    );
+    let pa = Rigid3::new(Quat::IDENTITY, Vec3A::new(1e30, 1.2556e-41, 0.0));
+    let pb = Rigid3::new(
+        Quat::from_xyzw(0.0, 1.001_403_8, 0.0, 0.0),
+        Vec3A::new(1e30, f32::MAX, f32::MAX),
+    );
+    let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+    assert!(exact_overlap(&a, &b, rel.matrix(), rel.translation()));
+    assert!(rel.overlaps(&a, &b));
+    assert_eq!(rel.pad(), f32::INFINITY);
+}
+
+#[test]
+fn adversarial_builds_find_every_overlap() {
+    // Exponentially spaced boxes (SAH would peel one per level) and boxes far from the
+    // origin (the quantized grid): the tree still finds every exact overlap.
+    let spaced: Vec<Aabb3> = (0..160)
+        .map(|k| aabb(Vec3::new(1.07f32.powi(k), 0.0, 0.0), Vec3::splat(0.3)))
+        .collect();
+    let far: Vec<Aabb3> = (0..120)
+        .map(|k| {
+            let c = Vec3::new(
+                1.0e5 + (k % 7) as f32 * 0.25,
+                -3.0e5 + (k / 7) as f32 * 0.25,
+                7.0e4,
+            );
+            aabb(c, Vec3::new(0.1, 0.2, 0.0))
+        })
+        .collect();
+    for boxes in [spaced, far] {
+        let compact = AabbTree::new(&boxes).unwrap();
+        let quantized = AabbTree::<Quantized>::build(&boxes).unwrap();
+        for (k, pose) in trimesh::poses(2, 0.3, 8).into_iter().enumerate() {
+            let c0 = boxes[0].center();
+            // B is A turned about A's first box (so that the far boxes still meet).
+            let pose = Rigid3::new(pose.rotation, c0 - pose.rotation * c0);
+            let q = compact.query(Rigid3::IDENTITY, &compact, pose);
+            let (pairs, qpairs) = (
+                q.leaf_pairs(),
+                quantized
+                    .query(Rigid3::IDENTITY, &quantized, pose)
+                    .leaf_pairs(),
+            );
+            let rel = q.relative();
+            let mut exact = 0;
+            for (i, a) in boxes.iter().enumerate() {
+                for (j, b) in boxes.iter().enumerate().step_by(4) {
+                    if exact_overlap(a, b, rel.matrix(), rel.translation()) {
+                        exact += 1;
+                        assert!(pairs.contains(&(i as u32, j as u32)), "compact, pose {k}");
+                        assert!(
+                            qpairs.contains(&(i as u32, j as u32)),
+                            "quantized, pose {k}"
+                        );
+                    }
+                }
+            }
+            assert!(exact > 0);
+        }
+    }
+}
