@@ -86,18 +86,10 @@ fn bench(c: &mut Criterion) {
             let kernel = format!("{}/{}", method.name(), rounding.name());
             let batch = Batch::new(method, rounding);
             g.bench_function(BenchmarkId::new("single", &kernel), |b| {
-                b.iter(|| {
-                    for ((bx, xf), o) in black_box(boxes).iter().zip(&s.affine).zip(&mut oa) {
-                        *o = bx.transformed(xf, method, rounding);
-                    }
-                })
+                b.iter(|| single_loop(black_box(boxes), &s.affine, &mut oa, method, rounding))
             });
             g.bench_function(BenchmarkId::new("single-rigid", &kernel), |b| {
-                b.iter(|| {
-                    for ((bx, xf), o) in black_box(boxes).iter().zip(&s.rigid).zip(&mut oa) {
-                        *o = bx.transformed(xf, method, rounding);
-                    }
-                })
+                b.iter(|| single_loop(black_box(boxes), &s.rigid, &mut oa, method, rounding))
             });
             g.bench_function(BenchmarkId::new("aos", &kernel), |b| {
                 b.iter(|| batch.transform(black_box(boxes), black_box(&s.affine), &mut oa))

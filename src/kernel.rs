@@ -56,14 +56,13 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 /// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo_j|, |hi_j|)` the face
 /// error is at most `γ(N+3)·S + TINY_ERROR`.
 ///
-/// The pad reuses what the method has: `2S = |2t| + |M|·(|2c| + 2e)`, with `|M|` already
-/// formed for `2e'`, is `N` more multiply-adds, applied to `2c' ∓ 2e'` before the halving.
+/// The pad reuses what the method has: `2S = |2t| + |M|·(|2c| + 2e)` is `N` more
+/// multiply-adds on the `|M|` of `2e'`, applied to `2c' ∓ 2e'` before the halving.
 /// The computed `|2c| + 2e` is at least `(1 − u)²·2·max(|lo|, |hi|)` and the dot product of
 /// positive terms loses at most `γ(N + 1)`, so the computed `2S` is at least
 /// `2S·(1 − γ(N + 3))`; the argument of [`outward_pad`] then applies with doubled terms
 /// (`2·TINY_PAD` covers the doubled `TINY_ERROR`, the pad's rounding and the halving).
 #[inline(always)]
-#[allow(clippy::needless_range_loop)] // indexed loops unroll; `axis(j)` needs a constant `j`
 pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     a: &AffineLanes<V, N>,
     lo: V,
@@ -72,23 +71,19 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
 ) -> (V, V) {
     let center2 = lo + hi;
     let extent2 = hi - lo;
-    let mut abs_cols = a.cols;
-    for col in &mut abs_cols {
-        *col = col.abs();
-    }
     let t2 = a.t + a.t;
     let mut world_center2 = a.cols[0].mul_add(center2.axis(0), t2);
-    let mut world_extent2 = abs_cols[0] * extent2.axis(0);
+    let mut world_extent2 = a.cols[0].abs() * extent2.axis(0);
     for j in 1..N {
         world_center2 = a.cols[j].mul_add(center2.axis(j), world_center2);
-        world_extent2 = abs_cols[j].mul_add(extent2.axis(j), world_extent2);
+        world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
     }
     let (mut min2, mut max2) = (world_center2 - world_extent2, world_center2 + world_extent2);
     if let Some(k) = pad_order {
         let reach2 = center2.abs() + extent2;
         let mut magnitude2 = t2.abs();
         for j in 0..N {
-            magnitude2 = abs_cols[j].mul_add(reach2.axis(j), magnitude2);
+            magnitude2 = a.cols[j].abs().mul_add(reach2.axis(j), magnitude2);
         }
         let pad2 = magnitude2.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(2.0 * TINY_PAD));
         (min2, max2) = (min2 - pad2, max2 + pad2);
@@ -98,44 +93,20 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
 }
 
 /// Sign-select: face `i` of the minimum is `t_i + sum_j m_ij * (m_ij >= 0 ? lo_j : hi_j)`,
-/// and the maximum takes the other face; padded outward by `k·u·S + TINY_PAD` when
-/// `pad_order` is `Some(k)`.
+/// and the maximum takes the other face. No center/extent round trip.
 ///
-/// Each term is chosen as `min(m·lo, m·hi)` (and `max` for the upper face): rounding is
-/// monotone, so that is exactly the rounded product the sign would select, without a
-/// comparison and two blends (three operations each on SSE2). A NaN product cannot hide:
-/// a NaN entry makes both products NaN, an infinite one makes the other product infinite,
-/// and NaN boxes never reach the kernel. The products are never fused with the sums, so
-/// every backend computes the same faces.
+/// Each step is [`Lane::add_signed_products`]: a sign test and two multiply-adds in the
+/// batch lanes, the smaller and larger of the two products on SSE2's `Vec3A`, which has
+/// no blend (rounding is monotone, so both choose the same rounded product).
 ///
-/// Error: `N` products and `N` additions per face, `γ(N+1)·S + TINY_ERROR`. The pad reuses
-/// the products: `S_i = |t_i| + sum_j max(|m_ij·lo_j|, |m_ij·hi_j|)`, the larger being
-/// `max(upper term, −lower term)`; the computed `S` is at least `S·(1 − γ(N + 1))`, as in
-/// [`outward_pad`].
+/// Error: `N` products and `N` additions per face, `γ(N+1)·S + TINY_ERROR`.
 #[inline(always)]
-pub(crate) fn sign_select<V: Axes, const N: usize>(
-    a: &AffineLanes<V, N>,
-    lo: V,
-    hi: V,
-    pad_order: Option<u32>,
-) -> (V, V) {
-    let (mut min, mut max, mut magnitude) = (a.t, a.t, a.t.abs());
+pub(crate) fn sign_select<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V) -> (V, V) {
+    let (mut min, mut max) = (a.t, a.t);
     for j in 0..N {
-        let (p, q) = (a.cols[j] * lo.axis(j), a.cols[j] * hi.axis(j));
-        let (lower, upper) = (p.min(q), p.max(q));
-        min = min + lower;
-        max = max + upper;
-        if pad_order.is_some() {
-            magnitude = magnitude + upper.max(-lower);
-        }
+        (min, max) = a.cols[j].add_signed_products(lo.axis(j), hi.axis(j), min, max);
     }
-    match pad_order {
-        Some(k) => {
-            let pad = magnitude.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(TINY_PAD));
-            (min - pad, max + pad)
-        }
-        None => (min, max),
-    }
+    (min, max)
 }
 
 /// Eberly's sign branch for a 2D rotation `[[c, −s], [s, c]]` plus translation.
@@ -206,7 +177,7 @@ pub(crate) fn bound<V: Axes, const N: usize>(
     match method {
         Method::Naive => naive(a, lo, hi),
         Method::AbsMatrix => abs_matrix(a, lo, hi, None),
-        Method::SignSelect => sign_select(a, lo, hi, None),
+        Method::SignSelect => sign_select(a, lo, hi),
     }
 }
 
@@ -221,19 +192,16 @@ pub(crate) fn transform<V: Axes, const N: usize>(
     outward: bool,
 ) -> (V, V) {
     let pad_order = outward.then(|| method.outward_pad(N as u32));
-    match method {
-        Method::Naive => {
-            let (min, max) = naive(a, lo, hi);
-            match pad_order {
-                Some(k) => {
-                    let pad = outward_pad(a, lo, hi, k);
-                    (min - pad, max + pad)
-                }
-                None => (min, max),
-            }
+    if method == Method::AbsMatrix {
+        return abs_matrix(a, lo, hi, pad_order);
+    }
+    let (min, max) = bound(a, lo, hi, method);
+    match pad_order {
+        Some(k) => {
+            let pad = outward_pad(a, lo, hi, k);
+            (min - pad, max + pad)
         }
-        Method::AbsMatrix => abs_matrix(a, lo, hi, pad_order),
-        Method::SignSelect => sign_select(a, lo, hi, pad_order),
+        None => (min, max),
     }
 }
 

@@ -30,6 +30,16 @@ pub trait Lane:
     fn mul_add(self, b: Self, c: Self) -> Self;
     /// Lane-wise `if self >= 0 { if_nonneg } else { otherwise }`.
     fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self;
+
+    /// One sign-select step: `self·(self >= 0 ? lo : hi)` added to `min` and
+    /// `self·(self >= 0 ? hi : lo)` added to `max`, each with [`Lane::mul_add`].
+    #[inline(always)]
+    fn add_signed_products(self, lo: Self, hi: Self, min: Self, max: Self) -> (Self, Self) {
+        (
+            self.mul_add(self.select_nonneg(lo, hi), min),
+            self.mul_add(self.select_nonneg(hi, lo), max),
+        )
+    }
 }
 
 /// A lane type whose lanes are the components of a vector, able to broadcast one of them.
@@ -100,6 +110,16 @@ impl Lane for Vec3A {
     #[inline(always)]
     fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
         Vec3A::select(self.cmpge(Vec3A::ZERO), if_nonneg, otherwise)
+    }
+    /// The smaller and larger of the two products: on SSE2 a select is three operations
+    /// and there is no blend, so `min`/`max` of `self·lo` and `self·hi` (the same rounded
+    /// products, rounding being monotone) is cheaper; never fused. A NaN product cannot
+    /// hide: a NaN entry makes both products NaN, an infinite one the other product
+    /// infinite, and NaN boxes never reach the kernel.
+    #[inline(always)]
+    fn add_signed_products(self, lo: Self, hi: Self, min: Self, max: Self) -> (Self, Self) {
+        let (p, q) = (self * lo, self * hi);
+        (min + p.min(q), max + p.max(q))
     }
 }
 

@@ -231,3 +231,30 @@ pub fn configure(
             .warm_up_time(Duration::from_millis(300));
     }
 }
+
+/// `out[k] = boxes[k].transformed(&xfs[k], method, rounding)` as a user writes it, with
+/// the method and rounding as constants at the call (each arm is its own loop).
+pub fn single_loop<T: bvkit::transform::Transform3>(
+    boxes: &[Aabb3],
+    xfs: &[T],
+    out: &mut [Aabb3],
+    method: bvkit::Method,
+    rounding: bvkit::Rounding,
+) {
+    use bvkit::{Method as M, Rounding as R};
+    macro_rules! each {
+        ($m:expr, $r:expr) => {
+            for ((b, xf), o) in boxes.iter().zip(xfs).zip(out) {
+                *o = b.transformed(xf, $m, $r);
+            }
+        };
+    }
+    match (method, rounding) {
+        (M::Naive, R::Nearest) => each!(M::Naive, R::Nearest),
+        (M::Naive, R::Outward) => each!(M::Naive, R::Outward),
+        (M::AbsMatrix, R::Nearest) => each!(M::AbsMatrix, R::Nearest),
+        (M::AbsMatrix, R::Outward) => each!(M::AbsMatrix, R::Outward),
+        (M::SignSelect, R::Nearest) => each!(M::SignSelect, R::Nearest),
+        (M::SignSelect, R::Outward) => each!(M::SignSelect, R::Outward),
+    }
+}
