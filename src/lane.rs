@@ -20,7 +20,7 @@ pub trait Lane:
     /// Every lane set to `x`.
     fn splat(x: f32) -> Self;
     /// Lane-wise minimum as `minps` computes it: `self < other ? self : other`, so equal
-    /// zeros and NaN operands give `other` (the callers never depend on NaN handling).
+    /// zeros give `other` (NaN handling varies by lane type; no caller depends on it).
     fn min(self, other: Self) -> Self;
     /// Lane-wise maximum as `maxps` computes it: `self > other ? self : other`.
     fn max(self, other: Self) -> Self;
@@ -114,8 +114,9 @@ impl Lane for Vec3A {
     /// The smaller and larger of the two products: on SSE2 a select is three operations
     /// and there is no blend, so `min`/`max` of `self·lo` and `self·hi` (the same rounded
     /// products, rounding being monotone) is cheaper; never fused. A NaN product cannot
-    /// hide: a NaN entry makes both products NaN, an infinite one the other product
-    /// infinite, and NaN boxes never reach the kernel.
+    /// hide a bad map: a NaN entry makes both products NaN and an infinite one the other
+    /// product infinite; a NaN box can give finite faces here, and fails the caller's
+    /// `min <= max` test instead.
     #[inline(always)]
     fn add_signed_products(self, lo: Self, hi: Self, min: Self, max: Self) -> (Self, Self) {
         let (p, q) = (self * lo, self * hi);
