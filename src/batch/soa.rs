@@ -187,6 +187,25 @@ fn common_len(
     }
 }
 
+/// Columns of equal length split into views of `chunk` values each (the last may be
+/// shorter), for the parallel batch.
+#[cfg(feature = "rayon")]
+fn split_columns<'p, T: Fields>(
+    columns: impl Iterator<Item = &'p mut [f32]>,
+    chunk: usize,
+) -> Vec<SoaMut<'p, T>> {
+    let mut len = 0;
+    let mut chunks: Vec<_> = columns
+        .map(|c| {
+            len = c.len();
+            c.chunks_mut(chunk)
+        })
+        .collect();
+    (0..len.div_ceil(chunk))
+        .map(|_| SoaMut::new(T::array(|n| chunks[n].next().unwrap_or_default())))
+        .collect()
+}
+
 /// Lanes `i..i + count` of every column: one vector load per column for a whole lane
 /// block, lane by lane for the tail.
 #[inline(always)]
@@ -279,16 +298,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
         Self: 'p;
     #[cfg(feature = "rayon")]
     fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, B>> {
-        let len = self.columns.as_ref().first().map_or(0, |c| c.len());
-        let mut columns: Vec<_> = self
-            .columns
-            .as_mut()
-            .iter_mut()
-            .map(|c| c.chunks_mut(chunk))
-            .collect();
-        (0..len.div_ceil(chunk))
-            .map(|_| SoaMut::new(B::array(|n| columns[n].next().unwrap_or_default())))
-            .collect()
+        split_columns(self.columns.as_mut().iter_mut().map(|c| &mut **c), chunk)
     }
 }
 
@@ -362,16 +372,10 @@ where
         Self: 'p;
     #[cfg(feature = "rayon")]
     fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, E>> {
-        let len = self.columns.as_ref().first().map_or(0, Vec::len);
-        let mut columns: Vec<_> = self
-            .columns
-            .as_mut()
-            .iter_mut()
-            .map(|c| c.chunks_mut(chunk))
-            .collect();
-        (0..len.div_ceil(chunk))
-            .map(|_| SoaMut::new(E::array(|n| columns[n].next().unwrap_or_default())))
-            .collect()
+        split_columns(
+            self.columns.as_mut().iter_mut().map(Vec::as_mut_slice),
+            chunk,
+        )
     }
 }
 
