@@ -71,6 +71,7 @@
 mod aabb;
 pub mod batch;
 mod block;
+pub mod broadphase;
 mod error;
 mod extended;
 mod fit;
@@ -86,6 +87,7 @@ pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
+pub use broadphase::{Active, LargeRigid3, Margin, Moved, Swept};
 pub use error::TransformError;
 pub use fit::{Capsule, Fit, FitError, Obb3, Sphere};
 pub use method::{Method, Rounding};

@@ -49,6 +49,14 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[B]>::len(self))
     }
+    type Read<'r>
+        = &'r [B]
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> &[B] {
+        self
+    }
     #[inline(always)]
     fn store<L: LaneArray>(
         &mut self,
@@ -147,6 +155,14 @@ impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
 impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.as_mut_slice())
+    }
+    type Read<'r>
+        = &'r [E]
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> &[E] {
+        self
     }
     #[inline(always)]
     fn store<L: LaneArray>(

@@ -170,6 +170,14 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[Block8<B>]>::len(self) * 8)
     }
+    type Read<'r>
+        = &'r [Block8<B>]
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> &[Block8<B>] {
+        self
+    }
     #[inline(always)]
     fn store<L: LaneArray>(
         &mut self,
@@ -258,6 +266,14 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.as_mut_slice())
+    }
+    type Read<'r>
+        = &'r [Block8<B>]
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> &[Block8<B>] {
+        self
     }
     #[inline(always)]
     fn store<L: LaneArray>(

@@ -46,7 +46,7 @@ use crate::aabb::Aabb3;
 pub(crate) use aos3::{Aos3, Maps};
 
 /// Why a batch was refused. Nothing was written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BatchError {
     /// Two inputs, or an input and the output, differ in length.
     LengthMismatch {
@@ -59,6 +59,12 @@ pub enum BatchError {
     },
     /// The backend asked for cannot run on this CPU.
     UnsupportedBackend(Backend),
+    /// A broadphase margin is negative, infinite or NaN.
+    InvalidMargin(crate::broadphase::Margin),
+    /// A broadphase active set is malformed; the reason is given.
+    InvalidActive(&'static str),
+    /// More objects than `u32` indices can name.
+    TooManyObjects(usize),
 }
 
 impl fmt::Display for BatchError {
@@ -73,6 +79,14 @@ impl fmt::Display for BatchError {
                 "{what} has length {found}, expected {expected} (the local boxes' length)"
             ),
             Self::UnsupportedBackend(b) => write!(f, "backend {b:?} is not supported by this CPU"),
+            Self::InvalidMargin(m) => write!(
+                f,
+                "margin {m:?} is invalid: both fields must be finite and non-negative"
+            ),
+            Self::InvalidActive(why) => write!(f, "invalid active set: {why}"),
+            Self::TooManyObjects(n) => {
+                write!(f, "{n} objects is more than u32 indices can name")
+            }
         }
     }
 }
@@ -130,6 +144,13 @@ pub(crate) mod sealed {
         fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
             None
         }
+        /// The same boxes as a source, for the broadphase update, which reads the fat
+        /// boxes it may rewrite.
+        type Read<'r>: ReadBoxes<N>
+        where
+            Self: 'r;
+        /// The boxes as a source.
+        fn read(&self) -> Self::Read<'_>;
         /// A part of the sink: the same layout over a run of boxes.
         #[cfg(feature = "rayon")]
         type Part<'p>: WriteBoxes<N> + Send

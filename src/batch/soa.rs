@@ -259,6 +259,15 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
             self.columns.as_ref().iter().map(|c| c.len()),
         )
     }
+    type Read<'r>
+        = SoaRef<'r, B>
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> SoaRef<'_, B> {
+        let columns = self.columns.as_ref();
+        SoaRef::new(B::array(|n| &*columns[n]))
+    }
     #[inline(always)]
     fn store<L: LaneArray>(
         &mut self,
@@ -348,9 +357,18 @@ where
 impl<const N: usize, E: Fields> WriteBoxes<N> for &mut Soa<E>
 where
     for<'b> SoaMut<'b, E>: WriteBoxes<N>,
+    for<'b> SoaRef<'b, E>: ReadBoxes<N>,
 {
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.view_mut())
+    }
+    type Read<'r>
+        = SoaRef<'r, E>
+    where
+        Self: 'r;
+    #[inline(always)]
+    fn read(&self) -> SoaRef<'_, E> {
+        self.view()
     }
     #[inline(always)]
     fn store<L: LaneArray>(

@@ -26,6 +26,8 @@ pub trait LaneArray: Lane {
     fn store(self, dst: &mut [f32]);
     /// True when any lane is not zero (NaN included).
     fn any_nonzero(self) -> bool;
+    /// Bit `k` set where lane `k` is not zero (NaN included).
+    fn nonzero_mask(self) -> u32;
 }
 
 impl LaneArray for f32 {
@@ -50,6 +52,10 @@ impl LaneArray for f32 {
     #[inline(always)]
     fn any_nonzero(self) -> bool {
         self != 0.0
+    }
+    #[inline(always)]
+    fn nonzero_mask(self) -> u32 {
+        u32::from(self != 0.0)
     }
 }
 
@@ -183,6 +189,15 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
         }
         any
     }
+    #[inline(always)]
+    fn nonzero_mask(self) -> u32 {
+        // One compare and one `movmskps` where the loop vectorises.
+        let mut mask = 0;
+        for k in 0..W {
+            mask |= u32::from(self.0[k] != 0.0) << k;
+        }
+        mask
+    }
 }
 
 impl Lane for wide::f32x8 {
@@ -237,5 +252,9 @@ impl LaneArray for wide::f32x8 {
     #[inline(always)]
     fn any_nonzero(self) -> bool {
         self.simd_ne(wide::f32x8::ZERO).any()
+    }
+    #[inline(always)]
+    fn nonzero_mask(self) -> u32 {
+        self.simd_ne(wide::f32x8::ZERO).to_bitmask()
     }
 }

@@ -1,0 +1,522 @@
+//! The per-frame broadphase update: fat boxes rewritten only when an object leaves them,
+//! and the set of objects whose fat box changed.
+//!
+//! A broadphase tree holds a *fat* box per object, larger than the object by a
+//! [`Margin`], so that small motions need no tree update. Each frame,
+//! [`Batch::update`] computes every active object's tight world box and compares it with
+//! its fat box:
+//! - inside: nothing is written;
+//! - outside (or NaN): the fat box is rewritten as the tight box grown by the margin and
+//!   rounded outward, and the object joins the [`Moved`] set, which the broadphase
+//!   reinserts.
+//!
+//! Every layout and transform class of [`crate::batch`] works, with the same method,
+//! rounding and backend, and so do [`Swept`] pose pairs (the union of the boxes at the
+//! current and the predicted pose, for continuous collision) and [`LargeWorld`] poses
+//! (`f64` positions, boxes relative to an `f64` origin, always rounded outward).
+//! [`Active`] restricts the update to a list or a mask of objects, so that sleeping and
+//! static objects cost nothing.
+//!
+//! ```
+//! use bvkit::broadphase::{Active, Margin, Moved};
+//! use bvkit::{Aabb3, Batch, Method, Rigid3, Rounding};
+//! use glam::{Quat, Vec3A};
+//!
+//! let local = vec![Aabb3::new(Vec3A::splat(-0.5), Vec3A::splat(0.5)); 100];
+//! let mut poses = vec![Rigid3::new(Quat::IDENTITY, Vec3A::ZERO); 100];
+//! let mut fat = vec![Aabb3::EMPTY; 100];
+//! let mut moved = Moved::new();
+//! let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+//! let margin = Margin::new(0.1, 0.0);
+//!
+//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+//! assert_eq!(moved.len(), 100); // every fat box was EMPTY
+//!
+//! poses[7].translation.x += 0.05; // within the margin: nothing moves
+//! poses[9].translation.x += 1.0; // out of its fat box
+//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+//! assert_eq!(moved.indices(), &[9]);
+//! # Ok::<(), bvkit::BatchError>(())
+//! ```
+
+mod fat;
+mod large;
+mod moved;
+
+use crate::aabb::Aabb3;
+use crate::batch::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
+use crate::batch::{Batch, BatchError, BoxSink, BoxSource};
+use crate::block;
+use crate::extended;
+use crate::lane::Vector;
+use crate::method::{Method, Rounding};
+use crate::simd::{self, Job, LaneArray};
+use crate::transform::Class;
+
+pub use fat::Margin;
+pub use large::{LargePose, LargeRigid3};
+pub use moved::Moved;
+
+use glam::DVec3;
+
+/// The objects an update visits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Active<'a> {
+    /// Every object.
+    All,
+    /// The objects at these indices, strictly ascending.
+    Indices(&'a [u32]),
+    /// The objects whose bit is set: bit `i % 64` of word `i / 64`, with `len.div_ceil(64)`
+    /// words and no bit at or past `len`.
+    Mask(&'a [u64]),
+}
+
+/// Two poses per object, the current and the predicted one: the tight box is the union of
+/// the boxes at both (the swept box of continuous collision detection), computed in the
+/// same pass.
+///
+/// Where either box needs the extended path (an overflow, an infinite face, a NaN), both
+/// are recomputed there: the union still contains both exact images, though its bits may
+/// differ from the union of two [`Batch::transform`] results. A NaN at either pose gives
+/// an invalid box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Swept<A, B> {
+    /// The poses at the start of the step.
+    pub current: A,
+    /// The poses at the end of the step.
+    pub predicted: B,
+}
+
+/// Large-world poses ([`LargeRigid3`] or `glam::DAffine3`, one per object) and the `f64`
+/// origin the boxes are relative to. Always rounded outward, whatever the batch's
+/// rounding; the method applies to the rotation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LargeWorld<'a, T> {
+    /// One pose per object.
+    pub poses: &'a [T],
+    /// The origin of the world boxes, in world units (the camera or the region's center).
+    pub origin: DVec3,
+}
+
+/// Poses an update reads: any [`TransformSource`](crate::TransformSource), a [`Swept`]
+/// pair of them, or a [`LargeWorld`].
+pub trait PoseSource<const N: usize>: sealed::Poses<N> {}
+impl<const N: usize, P: sealed::Poses<N>> PoseSource<N> for P {}
+
+pub(crate) mod sealed {
+    //! What a pose source must do: tight boxes in lanes, and one at a time on the
+    //! extended path.
+
+    use super::*;
+
+    /// Tight world boxes from local boxes.
+    pub trait Poses<const N: usize> {
+        /// Refuses a pose count other than `len` (a shared pose has none).
+        fn check_len(&self, len: usize) -> Result<(), BatchError>;
+        /// The tight boxes of objects `i..i + count` from their local boxes in lanes, and a
+        /// lane value that is 0 where the result stands and nonzero where the object must
+        /// be recomputed by [`Poses::tight_one`].
+        fn tight<L: LaneArray>(
+            &self,
+            i: usize,
+            count: usize,
+            lo: Vector<L, N>,
+            hi: Vector<L, N>,
+            method: Method,
+            outward: bool,
+        ) -> (Vector<L, N>, Vector<L, N>, L);
+        /// The tight box of object `i` on the extended path, which takes every input.
+        fn tight_one(
+            &self,
+            i: usize,
+            lo: [f32; N],
+            hi: [f32; N],
+            method: Method,
+            rounding: Rounding,
+        ) -> [[f32; N]; 2];
+    }
+}
+
+use sealed::Poses;
+
+impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
+    fn check_len(&self, len: usize) -> Result<(), BatchError> {
+        match self.len() {
+            Some(found) if found != len => Err(BatchError::LengthMismatch {
+                what: "poses",
+                expected: len,
+                found,
+            }),
+            _ => Ok(()),
+        }
+    }
+    #[inline(always)]
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        lo: Vector<L, N>,
+        hi: Vector<L, N>,
+        method: Method,
+        outward: bool,
+    ) -> (Vector<L, N>, Vector<L, N>, L) {
+        block::transform(&self.load::<L>(i, count), lo, hi, method, outward)
+    }
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; N],
+        hi: [f32; N],
+        _: Method,
+        rounding: Rounding,
+    ) -> [[f32; N]; 2] {
+        let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
+        [min, max]
+    }
+}
+
+impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
+    fn check_len(&self, len: usize) -> Result<(), BatchError> {
+        self.current.check_len(len)?;
+        self.predicted.check_len(len)
+    }
+    /// The union of the two boxes; a lane that does not stand at either pose does not
+    /// stand (so that a NaN at one pose is never hidden by the other's box).
+    #[inline(always)]
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        lo: Vector<L, N>,
+        hi: Vector<L, N>,
+        method: Method,
+        outward: bool,
+    ) -> (Vector<L, N>, Vector<L, N>, L) {
+        use crate::lane::Lane;
+        let (min0, max0, s0) = self.current.tight(i, count, lo, hi, method, outward);
+        let (min1, max1, s1) = self.predicted.tight(i, count, lo, hi, method, outward);
+        (min0.min(min1), max0.max(max1), s0.abs() + s1.abs())
+    }
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; N],
+        hi: [f32; N],
+        method: Method,
+        rounding: Rounding,
+    ) -> [[f32; N]; 2] {
+        let [min0, max0] = self.current.tight_one(i, lo, hi, method, rounding);
+        let [min1, max1] = self.predicted.tight_one(i, lo, hi, method, rounding);
+        if [min0, max0, min1, max1]
+            .iter()
+            .flatten()
+            .any(|x| x.is_nan())
+        {
+            return [[f32::NAN; N]; 2];
+        }
+        [
+            core::array::from_fn(|a| min0[a].min(min1[a])),
+            core::array::from_fn(|a| max0[a].max(max1[a])),
+        ]
+    }
+}
+
+impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
+    fn check_len(&self, len: usize) -> Result<(), BatchError> {
+        if self.poses.len() == len {
+            Ok(())
+        } else {
+            Err(BatchError::LengthMismatch {
+                what: "poses",
+                expected: len,
+                found: self.poses.len(),
+            })
+        }
+    }
+    /// One object at a time: the `f64` steps have no lane form.
+    #[inline(always)]
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        mut lo: Vector<L, 3>,
+        mut hi: Vector<L, 3>,
+        method: Method,
+        _: bool,
+    ) -> (Vector<L, 3>, Vector<L, 3>, L) {
+        for k in 0..count {
+            let lane = |v: &Vector<L, 3>| v.0.map(|x| x.get(k));
+            let [min, max] = self.tight_one(i + k, lane(&lo), lane(&hi), method, Rounding::Outward);
+            for a in 0..3 {
+                lo.0[a].set(k, min[a]);
+                hi.0[a].set(k, max[a]);
+            }
+        }
+        (lo, hi, L::splat(0.0))
+    }
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; 3],
+        hi: [f32; 3],
+        method: Method,
+        _: Rounding,
+    ) -> [[f32; 3]; 2] {
+        let local = Aabb3::new(lo.into(), hi.into());
+        let b = self.poses[i].relative_aabb(&local, self.origin, method);
+        [b.min.to_array(), b.max.to_array()]
+    }
+}
+
+impl Batch {
+    /// The broadphase update: for every [`Active`] object, its tight world box (`local`
+    /// through `poses`, with this batch's method, rounding and backend); where it is not
+    /// inside the object's box in `fat`, that box is rewritten as the tight box fattened
+    /// by `margin` ([`Aabb3::fattened`]) and the object joins `moved`. Every other fat box
+    /// is left untouched. `moved` is cleared first, and holds exactly the rewritten
+    /// objects, ascending; the result is deterministic.
+    ///
+    /// A tight box that is invalid (a NaN pose) is never inside a fat box: it is written,
+    /// and reported as moved at every update until its pose is valid again. An empty
+    /// local box is inside every valid fat box.
+    ///
+    /// # Errors
+    /// Nothing is written, and `moved` is untouched, when:
+    /// - [`BatchError::LengthMismatch`]: the poses (unless shared) or `fat` differ in
+    ///   length from `local`, or a SoA layout's columns disagree;
+    /// - [`BatchError::InvalidMargin`]: a margin field is negative, infinite or NaN;
+    /// - [`BatchError::InvalidActive`]: an index is out of range or not strictly
+    ///   ascending, or a mask has the wrong number of words or a bit past the last object;
+    /// - [`BatchError::TooManyObjects`]: more objects than `u32` indices can name.
+    pub fn update<const N: usize>(
+        &self,
+        margin: Margin,
+        active: Active<'_>,
+        local: impl BoxSource<N>,
+        poses: impl PoseSource<N>,
+        mut fat: impl BoxSink<N>,
+        moved: &mut Moved,
+    ) -> Result<(), BatchError> {
+        margin.check()?;
+        let len = local.len()?;
+        poses.check_len(len)?;
+        let fat_len = fat.len()?;
+        if fat_len != len {
+            return Err(BatchError::LengthMismatch {
+                what: "fat boxes",
+                expected: len,
+                found: fat_len,
+            });
+        }
+        if len > u32::MAX as usize + 1 {
+            return Err(BatchError::TooManyObjects(len));
+        }
+        check_active(active, len)?;
+        moved.reset(len);
+        let update = Update {
+            local,
+            poses,
+            fat,
+            len,
+            method: self.method,
+            rounding: self.rounding,
+            margin,
+            active,
+            moved,
+        };
+        simd::dispatch(self.backend(), !self.is_deterministic(), update);
+        Ok(())
+    }
+}
+
+/// Refuses indices out of range or out of order, and masks of the wrong shape.
+fn check_active(active: Active<'_>, len: usize) -> Result<(), BatchError> {
+    let refuse = |why| Err(BatchError::InvalidActive(why));
+    match active {
+        Active::All => Ok(()),
+        Active::Indices(ix) => {
+            if ix.last().is_some_and(|&i| i as usize >= len) {
+                return refuse("an index is past the last object");
+            }
+            if ix.windows(2).any(|w| w[0] >= w[1]) {
+                return refuse("the indices are not strictly ascending");
+            }
+            Ok(())
+        }
+        Active::Mask(words) => {
+            if words.len() != len.div_ceil(64) {
+                return refuse("the mask does not have len.div_ceil(64) words");
+            }
+            let tail = len % 64;
+            if tail != 0 && words.last().is_some_and(|w| w >> tail != 0) {
+                return refuse("the mask has a bit past the last object");
+            }
+            Ok(())
+        }
+    }
+}
+
+/// The update as a job for the dispatcher.
+struct Update<'a, const N: usize, B, P, F> {
+    local: B,
+    poses: P,
+    fat: F,
+    len: usize,
+    method: Method,
+    rounding: Rounding,
+    margin: Margin,
+    active: Active<'a>,
+    moved: &'a mut Moved,
+}
+
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Job
+    for Update<'_, N, B, P, F>
+{
+    /// One loop per method, as in [`Batch::transform`].
+    #[inline(always)]
+    fn run<L: LaneArray>(mut self) {
+        let outward = self.rounding == Rounding::Outward;
+        match self.method {
+            Method::Naive => self.visit::<L>(Method::Naive, outward),
+            Method::AbsMatrix => self.visit::<L>(Method::AbsMatrix, outward),
+            Method::SignSelect => self.visit::<L>(Method::SignSelect, outward),
+        }
+    }
+}
+
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, N, B, P, F> {
+    /// The active objects as runs: whole lane blocks where they are contiguous, one lane
+    /// of the same arithmetic for scattered ones (one call site of each, so that the
+    /// kernels are inlined twice per method, as in [`Batch::transform`]).
+    #[inline(always)]
+    fn visit<L: LaneArray>(&mut self, method: Method, outward: bool) {
+        for (start, end) in Spans::new(self.active, self.len) {
+            self.run_of::<L>(start, end, method, outward);
+        }
+    }
+
+    /// Objects `start..end`, `start` a multiple of the lane width.
+    #[inline(always)]
+    fn run_of<L: LaneArray>(&mut self, start: usize, end: usize, method: Method, outward: bool) {
+        let mut i = start;
+        while i + L::WIDTH <= end {
+            self.block::<L>(i, L::WIDTH, method, outward);
+            i += L::WIDTH;
+        }
+        while i < end {
+            self.block::<L::One>(i, 1, method, outward);
+            i += 1;
+        }
+    }
+
+    /// Objects `i..i + count`: the tight boxes in lanes, the fat boxes they leave rewritten
+    /// (the whole block at once when every lane left), and the lanes that do not stand
+    /// redone one at a time on the extended path.
+    #[inline(always)]
+    fn block<L: LaneArray>(&mut self, i: usize, count: usize, method: Method, outward: bool) {
+        let lanes = if count == 32 {
+            u32::MAX
+        } else {
+            (1 << count) - 1
+        };
+        let (lo, hi) = self.local.load::<L>(i, count);
+        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
+        let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
+        let redo = stands.nonzero_mask() & lanes;
+        let left = fat::outside(min, max, fat_min, fat_max).nonzero_mask() & lanes & !redo;
+        if left != 0 {
+            let (min, max) = self.margin.grow(min, max);
+            if left == lanes {
+                self.fat.store(i, count, min, max);
+            } else {
+                let mut bits = left;
+                while bits != 0 {
+                    let k = bits.trailing_zeros() as usize;
+                    let lane = |v: &Vector<L, N>| v.0.map(|x| x.get(k));
+                    self.fat.set(i + k, lane(&min), lane(&max));
+                    bits &= bits - 1;
+                }
+            }
+        }
+        let mut moved = left;
+        let mut bits = redo;
+        while bits != 0 {
+            let k = bits.trailing_zeros() as usize;
+            if self.redo(i + k, method) {
+                moved |= 1 << k;
+            }
+            bits &= bits - 1;
+        }
+        self.moved.record(i, moved);
+    }
+
+    /// Object `i` on the extended path; true when its fat box was rewritten.
+    #[cold]
+    fn redo(&mut self, i: usize, method: Method) -> bool {
+        let (lo, hi) = self.local.get(i);
+        let tight = self.poses.tight_one(i, lo, hi, method, self.rounding);
+        if fat::inside(tight, self.fat.read().get(i).into()) {
+            return false;
+        }
+        let (min, max) = self
+            .margin
+            .grow::<f32, N>(Vector(tight[0]), Vector(tight[1]));
+        self.fat.set(i, min.0, max.0);
+        true
+    }
+}
+
+/// The runs `start..end` of active objects, ascending: the whole range, whole words of a
+/// mask and its single bits, or single indices. Every run starts at a multiple of 64 or
+/// has length 1, so lane blocks stay aligned.
+struct Spans<'a> {
+    active: Active<'a>,
+    len: usize,
+    /// The next index, word or (for [`Active::All`]) 0 or 1.
+    at: usize,
+    /// The bits of the current mask word not yet visited.
+    bits: u64,
+}
+
+impl<'a> Spans<'a> {
+    fn new(active: Active<'a>, len: usize) -> Self {
+        Self {
+            active,
+            len,
+            at: 0,
+            bits: 0,
+        }
+    }
+}
+
+impl Iterator for Spans<'_> {
+    type Item = (usize, usize);
+    #[inline(always)]
+    fn next(&mut self) -> Option<(usize, usize)> {
+        match self.active {
+            Active::All => {
+                self.at += 1;
+                (self.at == 1).then_some((0, self.len))
+            }
+            Active::Indices(ix) => {
+                let i = *ix.get(self.at)? as usize;
+                self.at += 1;
+                Some((i, i + 1))
+            }
+            Active::Mask(words) => {
+                while self.bits == 0 {
+                    let word = *words.get(self.at)?;
+                    self.at += 1;
+                    if word == u64::MAX {
+                        let start = 64 * (self.at - 1);
+                        return Some((start, start + 64));
+                    }
+                    self.bits = word;
+                }
+                let i = 64 * (self.at - 1) + self.bits.trailing_zeros() as usize;
+                self.bits &= self.bits - 1;
+                Some((i, i + 1))
+            }
+        }
+    }
+}
