@@ -29,10 +29,22 @@ pub(crate) struct Aos3<'a, T> {
     pub rounding: Rounding,
 }
 
-impl<T: Transform3> Aos3<'_, T> {
-    /// Runs the batch and returns true on the SIMD backends; returns false on the scalar
-    /// reference and `wide`, which keep their own lanes.
-    pub fn run(self, backend: Backend) -> bool {
+/// A job over AoS 3D boxes that runs the single-box kernel of its class `T`, which the
+/// generic batch code knows only as a [`Class`](crate::transform::Class): the class's
+/// `run_simd3` hook runs it where `T` is a [`Transform3`].
+pub(crate) trait Simd3Job<T> {
+    /// Runs the job and returns true, or returns false where `backend` keeps its own
+    /// lanes (the scalar reference and `wide`).
+    fn run(self, backend: Backend) -> bool
+    where
+        T: Transform3;
+}
+
+impl<T> Simd3Job<T> for Aos3<'_, T> {
+    fn run(self, backend: Backend) -> bool
+    where
+        T: Transform3,
+    {
         match backend {
             Backend::Baseline | Backend::Avx2 | Backend::Avx512 => {
                 // One loop per method and rounding, each specialised to its kernel.
@@ -61,7 +73,9 @@ impl<T: Transform3> Aos3<'_, T> {
             Backend::Scalar | Backend::Wide => false,
         }
     }
+}
 
+impl<T: Transform3> Aos3<'_, T> {
     #[inline(always)]
     fn boxes(self, method: Method, rounding: Rounding) {
         match self.maps {

@@ -43,7 +43,7 @@ pub use soa::{
 };
 
 use crate::aabb::Aabb3;
-pub(crate) use aos3::{Aos3, Maps};
+pub(crate) use aos3::{Aos3, Maps, Simd3Job};
 
 /// Why a batch was refused. Nothing was written.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -376,7 +376,7 @@ impl Batch {
                 method: self.method,
                 rounding: self.rounding,
             };
-            if Class::run_aos3(batch, self.backend) {
+            if Class::run_simd3(batch, self.backend) {
                 return Ok(());
             }
         }

@@ -4,6 +4,7 @@
 use crate::batch::BatchError;
 use crate::lane::{Lane, Vector};
 use crate::{Aabb2, Aabb3};
+use glam::Vec3A;
 
 /// How much a fat box exceeds the tight box it was made from, per axis:
 /// `max(absolute, relative × half-extent)`, in world units.
@@ -104,11 +105,12 @@ pub(crate) fn inside<const N: usize>(
 impl Aabb3 {
     /// The fat box of this tight box: grown by `margin` on every axis and rounded outward,
     /// so that it contains the exact grown box (see [`Batch::update`](crate::Batch::update)).
+    #[inline]
     #[must_use]
     pub fn fattened(&self, margin: Margin) -> Aabb3 {
-        let (min, max) =
-            margin.grow::<f32, 3>(Vector(self.min.to_array()), Vector(self.max.to_array()));
-        Aabb3::new(min.0.into(), max.0.into())
+        // On `Vec3A` lanes: per axis the same operations, so the same bits, as in any lanes.
+        let (min, max) = margin.grow::<Vec3A, 1>(Vector([self.min]), Vector([self.max]));
+        Aabb3::new(min.0[0], max.0[0])
     }
 }
 

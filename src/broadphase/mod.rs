@@ -45,13 +45,13 @@ mod moved;
 
 use crate::aabb::Aabb3;
 use crate::batch::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use crate::batch::{Batch, BatchError, BoxSink, BoxSource};
+use crate::batch::{Batch, BatchError, BoxSink, BoxSource, Maps, Simd3Job};
 use crate::block;
 use crate::extended;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
-use crate::simd::{self, Job, LaneArray};
-use crate::transform::Class;
+use crate::simd::{self, Backend, Job, LaneArray};
+use crate::transform::{Class, Transform3};
 
 pub use fat::Margin;
 pub use large::{LargePose, LargeRigid3};
@@ -134,6 +134,12 @@ pub(crate) mod sealed {
             method: Method,
             rounding: Rounding,
         ) -> [[f32; N]; 2];
+        /// Runs an update of AoS 3D boxes on the single-box kernel and returns true, or
+        /// returns false where these poses or the backend have none.
+        fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
+            let _ = (update, backend);
+            false
+        }
     }
 }
 
@@ -172,6 +178,12 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     ) -> [[f32; N]; 2] {
         let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
         [min, max]
+    }
+    fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
+        match self.maps() {
+            Some(maps) => X::Class::run_simd3(AosUpdateOn { maps, update }, backend),
+            None => false,
+        }
     }
 }
 
@@ -313,6 +325,22 @@ impl Batch {
         }
         check_active(active, len)?;
         moved.reset(len);
+        if let (false, Some(local), Some(fat)) =
+            (self.is_deterministic(), local.aabb3s(), fat.aabb3s_mut())
+        {
+            let update = AosUpdate {
+                local,
+                fat,
+                active,
+                moved: &mut *moved,
+                margin,
+                method: self.method,
+                rounding: self.rounding,
+            };
+            if poses.update_aos3(update, self.backend()) {
+                return Ok(());
+            }
+        }
         let update = Update {
             local,
             poses,
@@ -326,6 +354,153 @@ impl Batch {
         };
         simd::dispatch(self.backend(), !self.is_deterministic(), update);
         Ok(())
+    }
+}
+
+/// An update of AoS 3D boxes, its inputs checked: run on the single-box kernel, since
+/// gathering AoS boxes into lanes costs more than the kernel (as for
+/// [`Batch::transform`]).
+pub(crate) struct AosUpdate<'a> {
+    local: &'a [Aabb3],
+    fat: &'a mut [Aabb3],
+    active: Active<'a>,
+    moved: &'a mut Moved,
+    margin: Margin,
+    method: Method,
+    rounding: Rounding,
+}
+
+/// An [`AosUpdate`] with its poses, one per box or shared.
+struct AosUpdateOn<'a, T> {
+    maps: Maps<'a, T>,
+    update: AosUpdate<'a>,
+}
+
+impl<T> Simd3Job<T> for AosUpdateOn<'_, T> {
+    fn run(self, backend: Backend) -> bool
+    where
+        T: Transform3,
+    {
+        if let Backend::Scalar | Backend::Wide = backend {
+            return false;
+        }
+        // One loop per method and rounding, each specialised to its kernel.
+        let u = &self.update;
+        match (u.method, u.rounding) {
+            (Method::Naive, Rounding::Nearest) => self.objects(Method::Naive, Rounding::Nearest),
+            (Method::Naive, Rounding::Outward) => self.objects(Method::Naive, Rounding::Outward),
+            (Method::AbsMatrix, Rounding::Nearest) => {
+                self.objects(Method::AbsMatrix, Rounding::Nearest)
+            }
+            (Method::AbsMatrix, Rounding::Outward) => {
+                self.objects(Method::AbsMatrix, Rounding::Outward)
+            }
+            (Method::SignSelect, Rounding::Nearest) => {
+                self.objects(Method::SignSelect, Rounding::Nearest)
+            }
+            (Method::SignSelect, Rounding::Outward) => {
+                self.objects(Method::SignSelect, Rounding::Outward)
+            }
+        }
+        true
+    }
+}
+
+impl<T: Transform3> AosUpdateOn<'_, T> {
+    /// Every active object through [`Aabb3::transformed`], its fat box compared and
+    /// rewritten on `Vec3A` (the same arithmetic, so the same bits, as the lanes).
+    #[inline(always)]
+    fn objects(self, method: Method, rounding: Rounding) {
+        let AosUpdate {
+            local,
+            fat,
+            active,
+            moved,
+            margin,
+            ..
+        } = self.update;
+        let maps = self.maps;
+        let pose = |i: usize| match maps {
+            Maps::Each(poses) => &poses[i],
+            Maps::Shared(pose) => pose,
+        };
+        let mut object = |fat: &mut [Aabb3], i: usize| {
+            let tight = local[i].transformed(pose(i), method, rounding);
+            let f = &mut fat[i];
+            if !(f.min.cmple(tight.min).all() && tight.max.cmple(f.max).all()) {
+                *f = tight.fattened(margin);
+                moved.record(i, 1);
+            }
+        };
+        // Scattered objects: their lines are requested `AHEAD` objects in advance.
+        let ahead = |fat: &[Aabb3], i: usize| {
+            simd::prefetch(&local[i]);
+            simd::prefetch(&fat[i]);
+            simd::prefetch(pose(i));
+        };
+        match active {
+            Active::All => (0..local.len()).for_each(|i| object(fat, i)),
+            _ => {
+                let mut early = ActiveIndices::new(active);
+                early.by_ref().take(AHEAD).for_each(|i| ahead(fat, i));
+                for i in ActiveIndices::new(active) {
+                    if let Some(j) = early.next() {
+                        ahead(fat, j);
+                    }
+                    object(fat, i);
+                }
+            }
+        }
+    }
+}
+
+/// How many scattered objects ahead the update requests memory.
+const AHEAD: usize = 16;
+
+/// The indices of an index list or a mask, ascending.
+struct ActiveIndices<'a> {
+    active: Active<'a>,
+    /// The next position in the list, or the current mask word.
+    at: usize,
+    /// The bits of the current mask word not yet visited.
+    bits: u64,
+}
+
+impl<'a> ActiveIndices<'a> {
+    fn new(active: Active<'a>) -> Self {
+        let bits = match active {
+            Active::Mask(words) => words.first().copied().unwrap_or(0),
+            _ => 0,
+        };
+        Self {
+            active,
+            at: 0,
+            bits,
+        }
+    }
+}
+
+impl Iterator for ActiveIndices<'_> {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        match self.active {
+            Active::All => None,
+            Active::Indices(ix) => {
+                let i = *ix.get(self.at)?;
+                self.at += 1;
+                Some(i as usize)
+            }
+            Active::Mask(words) => {
+                while self.bits == 0 {
+                    self.at += 1;
+                    self.bits = *words.get(self.at)?;
+                }
+                let i = 64 * self.at + self.bits.trailing_zeros() as usize;
+                self.bits &= self.bits - 1;
+                Some(i)
+            }
+        }
     }
 }
 
@@ -385,58 +560,90 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Job
 }
 
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, N, B, P, F> {
-    /// The active objects as runs: whole lane blocks where they are contiguous, one lane
-    /// of the same arithmetic for scattered ones (one call site of each, so that the
-    /// kernels are inlined twice per method, as in [`Batch::transform`]).
+    /// The active objects in aligned lane blocks: a block with more than one active lane
+    /// runs in lanes (its inactive lanes are computed and ignored), a lone active object
+    /// and the tail run one lane of the same arithmetic (one call site of each, so that
+    /// the kernels are inlined twice per method, as in [`Batch::transform`]).
     #[inline(always)]
     fn visit<L: LaneArray>(&mut self, method: Method, outward: bool) {
-        for (start, end) in Spans::new(self.active, self.len) {
-            self.run_of::<L>(start, end, method, outward);
-        }
-    }
-
-    /// Objects `start..end`, `start` a multiple of the lane width.
-    #[inline(always)]
-    fn run_of<L: LaneArray>(&mut self, start: usize, end: usize, method: Method, outward: bool) {
-        let mut i = start;
-        while i + L::WIDTH <= end {
-            self.block::<L>(i, L::WIDTH, method, outward);
-            i += L::WIDTH;
-        }
-        while i < end {
-            self.block::<L::One>(i, 1, method, outward);
-            i += 1;
-        }
-    }
-
-    /// Objects `i..i + count`: the tight boxes in lanes, the fat boxes they leave rewritten
-    /// (the whole block at once when every lane left), and the lanes that do not stand
-    /// redone one at a time on the extended path.
-    #[inline(always)]
-    fn block<L: LaneArray>(&mut self, i: usize, count: usize, method: Method, outward: bool) {
-        let lanes = if count == 32 {
-            u32::MAX
-        } else {
-            (1 << count) - 1
-        };
-        let (lo, hi) = self.local.load::<L>(i, count);
-        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
-        let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
-        let redo = stands.nonzero_mask() & lanes;
-        let left = fat::outside(min, max, fat_min, fat_max).nonzero_mask() & lanes & !redo;
-        if left != 0 {
-            let (min, max) = self.margin.grow(min, max);
-            if left == lanes {
-                self.fat.store(i, count, min, max);
+        for (start, count, active) in Blocks::new(self.active, self.len, L::WIDTH) {
+            if count == L::WIDTH && active & (active - 1) != 0 {
+                self.block::<L>(start, L::WIDTH, active, method, outward);
             } else {
-                let mut bits = left;
+                let mut bits = active;
                 while bits != 0 {
                     let k = bits.trailing_zeros() as usize;
-                    let lane = |v: &Vector<L, N>| v.0.map(|x| x.get(k));
-                    self.fat.set(i + k, lane(&min), lane(&max));
+                    self.block::<L::One>(start + k, 1, 1, method, outward);
                     bits &= bits - 1;
                 }
             }
+        }
+    }
+
+    /// Objects `i..i + count`, of which the `lanes` bits are active: the tight boxes in
+    /// lanes, the fat boxes they leave rewritten, and the lanes that do not stand redone
+    /// one at a time on the extended path.
+    #[inline(always)]
+    fn block<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u32,
+        method: Method,
+        outward: bool,
+    ) {
+        let (lo, hi) = self.local.load::<L>(i, count);
+        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
+        let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
+        let outside = fat::outside(min, max, fat_min, fat_max);
+        // The common case, every box inside its fat box and standing: one reduction.
+        if !(outside + stands).any_nonzero() {
+            return;
+        }
+        self.rewrite(
+            i,
+            count,
+            lanes,
+            method,
+            [outside, stands],
+            [min, max],
+            [fat_min, fat_max],
+        );
+    }
+
+    /// The rest of a block where a box left its fat box or did not stand: the fat boxes
+    /// rewritten and the objects recorded. Out of line: inlined, its code (though rarely
+    /// run) made LLVM spill the hot path, which then ran three times slower. It uses no
+    /// multiply-add, so it needs none of the dispatcher's target features.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn rewrite<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u32,
+        method: Method,
+        [outside, stands]: [L; 2],
+        [min, max]: [Vector<L, N>; 2],
+        [fat_min, fat_max]: [Vector<L, N>; 2],
+    ) {
+        let redo = stands.nonzero_mask() & lanes;
+        let left = outside.nonzero_mask() & lanes & !redo;
+        if left != 0 {
+            // The whole block is stored, the lanes that stay with their own bits: lanes
+            // picked by a dynamic index would pin the vectors to memory and stop LLVM from
+            // vectorising the block.
+            let (grown_min, grown_max) = self.margin.grow(min, max);
+            let mut keep = L::splat(0.0);
+            for k in 0..L::WIDTH {
+                keep.set(k, if left >> k & 1 != 0 { 0.0 } else { -1.0 });
+            }
+            let (mut min, mut max) = (fat_min, fat_max);
+            for a in 0..N {
+                min.0[a] = keep.select_nonneg(grown_min.0[a], fat_min.0[a]);
+                max.0[a] = keep.select_nonneg(grown_max.0[a], fat_max.0[a]);
+            }
+            self.fat.store(i, count, min, max);
         }
         let mut moved = left;
         let mut bits = redo;
@@ -466,56 +673,78 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
     }
 }
 
-/// The runs `start..end` of active objects, ascending: the whole range, whole words of a
-/// mask and its single bits, or single indices. Every run starts at a multiple of 64 or
-/// has length 1, so lane blocks stay aligned.
-struct Spans<'a> {
+/// The active objects in aligned blocks of `width` (1, 8 or 16) lanes, ascending:
+/// `(start, count, active)` with `start` a multiple of `width`, `count` the lanes that
+/// exist (`width`, or fewer in the last block) and `active` the nonzero mask of the active
+/// ones. Empty mask words are skipped whole.
+struct Blocks<'a> {
     active: Active<'a>,
     len: usize,
-    /// The next index, word or (for [`Active::All`]) 0 or 1.
+    width: usize,
+    /// The next block's start, or the next position in an index list.
     at: usize,
-    /// The bits of the current mask word not yet visited.
-    bits: u64,
 }
 
-impl<'a> Spans<'a> {
-    fn new(active: Active<'a>, len: usize) -> Self {
+impl<'a> Blocks<'a> {
+    fn new(active: Active<'a>, len: usize, width: usize) -> Self {
         Self {
             active,
             len,
+            width,
             at: 0,
-            bits: 0,
         }
+    }
+
+    /// The lanes of the block at `start`, and the mask of all of them.
+    #[inline(always)]
+    fn lanes(&self, start: usize) -> (usize, u32) {
+        let count = self.width.min(self.len - start);
+        (count, (((1u64 << count) - 1) as u32))
     }
 }
 
-impl Iterator for Spans<'_> {
-    type Item = (usize, usize);
+impl Iterator for Blocks<'_> {
+    type Item = (usize, usize, u32);
     #[inline(always)]
-    fn next(&mut self) -> Option<(usize, usize)> {
+    fn next(&mut self) -> Option<(usize, usize, u32)> {
         match self.active {
             Active::All => {
-                self.at += 1;
-                (self.at == 1).then_some((0, self.len))
-            }
-            Active::Indices(ix) => {
-                let i = *ix.get(self.at)? as usize;
-                self.at += 1;
-                Some((i, i + 1))
-            }
-            Active::Mask(words) => {
-                while self.bits == 0 {
-                    let word = *words.get(self.at)?;
-                    self.at += 1;
-                    if word == u64::MAX {
-                        let start = 64 * (self.at - 1);
-                        return Some((start, start + 64));
-                    }
-                    self.bits = word;
+                let start = self.at;
+                if start >= self.len {
+                    return None;
                 }
-                let i = 64 * (self.at - 1) + self.bits.trailing_zeros() as usize;
-                self.bits &= self.bits - 1;
-                Some((i, i + 1))
+                self.at += self.width;
+                let (count, all) = self.lanes(start);
+                Some((start, count, all))
+            }
+            Active::Mask(words) => loop {
+                let start = self.at;
+                if start >= self.len {
+                    return None;
+                }
+                // Straight to the block of the next set bit, a whole empty word at a time.
+                let word = words[start / 64];
+                let rest = word >> (start % 64);
+                if rest == 0 {
+                    self.at = (start / 64 + 1) * 64;
+                    continue;
+                }
+                let next = start + rest.trailing_zeros() as usize;
+                let block = next - next % self.width;
+                self.at = block + self.width;
+                let (count, all) = self.lanes(block);
+                return Some((block, count, (word >> (block % 64)) as u32 & all));
+            },
+            Active::Indices(ix) => {
+                let first = *ix.get(self.at)? as usize;
+                let start = first - first % self.width;
+                let (count, _) = self.lanes(start);
+                let mut active = 0;
+                while let Some(&i) = ix.get(self.at).filter(|&&i| (i as usize) < start + count) {
+                    active |= 1 << (i as usize - start);
+                    self.at += 1;
+                }
+                Some((start, count, active))
             }
         }
     }

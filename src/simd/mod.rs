@@ -155,3 +155,21 @@ fn run_avx2<J: Job, L: LaneArray>(job: J) {
 fn run_avx512<J: Job, L: LaneArray>(job: J) {
     job.run::<L>();
 }
+
+/// Asks the CPU to start loading the cache line of `x`: a hint, with no effect on any
+/// result. Scattered updates issue it a few objects ahead, since their kernels are too long
+/// for the out-of-order window to overlap more than one or two cache misses.
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: `_mm_prefetch` reads nothing and never faults, whatever the address (here a
+    // live reference); its only requirement, SSE, is part of the x86-64 baseline.
+    unsafe {
+        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}

@@ -3,7 +3,7 @@
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
 use super::{Class, Fields, MAX_FIELDS, Simd3, Transform2, Transform3, vector_at};
-use crate::batch::Aos3;
+use crate::batch::Simd3Job;
 use crate::extended::ExtendedMap;
 use crate::kernel::AffineLanes;
 use crate::lane::{Lane, Vector};
@@ -36,8 +36,8 @@ impl Fields for Affine3A {
 }
 
 impl Class<3> for Affine3A {
-    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-        batch.run(backend)
+    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+        job.run(backend)
     }
     type Lanes<L: Lane> = AffineLanes<Vector<L, 3>, 3>;
     #[inline(always)]

@@ -84,7 +84,7 @@ pub(crate) mod sealed {
     //! becomes lanes, its kernel and its extended-range form.
 
     use super::*;
-    use crate::batch::Aos3;
+    use crate::batch::Simd3Job;
     use crate::extended::ExtendedMap;
     use crate::lane::{Lane, Vector};
     use crate::simd::Backend;
@@ -135,11 +135,11 @@ pub(crate) mod sealed {
         fn extended(&self) -> ExtendedMap<N>;
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
-        /// Runs a 3D AoS batch on the single-box path and returns true, or returns false
-        /// where the class or the backend has none (2D classes, the scalar and `wide`
-        /// backends).
-        fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-            let _ = (batch, backend);
+        /// Runs a job on the single-box kernel (a 3D AoS batch or update) and returns
+        /// true, or returns false where the class or the backend has none (2D classes,
+        /// the scalar and `wide` backends).
+        fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+            let _ = (job, backend);
             false
         }
     }

@@ -8,7 +8,7 @@
 use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
 use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform3, vector_at};
-use crate::batch::Aos3;
+use crate::batch::Simd3Job;
 use crate::extended::ExtendedMap;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Axes, Lane, Vector};
@@ -323,8 +323,8 @@ impl Fields for Trs3 {
 }
 
 impl Class<3> for Rigid3 {
-    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-        batch.run(backend)
+    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+        job.run(backend)
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
     #[inline(always)]
@@ -340,8 +340,8 @@ impl Class<3> for Rigid3 {
 }
 
 impl Class<3> for Similarity3 {
-    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-        batch.run(backend)
+    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+        job.run(backend)
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
@@ -358,8 +358,8 @@ impl Class<3> for Similarity3 {
 }
 
 impl Class<3> for Trs3 {
-    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-        batch.run(backend)
+    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+        job.run(backend)
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]

@@ -3,7 +3,7 @@
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
 use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform2, Transform3, vector_at};
-use crate::batch::Aos3;
+use crate::batch::Simd3Job;
 use crate::extended::ExtendedMap;
 use crate::kernel;
 use crate::lane::{Lane, Vector};
@@ -113,8 +113,8 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
-    fn run_aos3(batch: Aos3<'_, Self>, backend: Backend) -> bool {
-        batch.run(backend)
+    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
+        job.run(backend)
     }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
     #[inline(always)]

@@ -1,0 +1,157 @@
+//! The broadphase update at 1M objects with 1%, 10% and 100% active, in ns per active
+//! object, next to the memory roofline of the bytes it moves and the naive path that
+//! rewrites every box. `cargo bench --bench broadphase`; `scripts/broadphase_report.py`
+//! tabulates a run.
+//!
+//! Two cases per fraction: `stay` (no object leaves its fat box: the update reads the
+//! local box, the pose and the fat box, 96 bytes per active object, and writes nothing)
+//! and `moved` (every active object leaves it, alternating between two poses: 32 more
+//! bytes written, and its index). Active subsets are sorted random index lists.
+
+mod common;
+
+use std::hint::black_box;
+
+use bvkit::{Aabb3, Active, Backend, Batch, Margin, Method, Moved, Rigid3, Rounding};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3A;
+
+use common::*;
+
+const N: usize = 1 << 20;
+
+/// The memory roofline of the update: the same bytes read (and, when `write`, the fat
+/// boxes written and the index stored) with one addition per vector.
+fn roofline(
+    active: Option<&[u32]>,
+    local: &[Aabb3],
+    poses: &[Rigid3],
+    fat: &mut [Aabb3],
+    write: bool,
+    moved: &mut Vec<u32>,
+) -> Vec3A {
+    moved.clear();
+    let mut acc = Vec3A::ZERO;
+    let mut visit = |i: usize| {
+        let (b, p, f) = (&local[i], &poses[i], &mut fat[i]);
+        let q = Vec3A::from(p.rotation.xyz()) + Vec3A::splat(p.rotation.w) + p.translation;
+        let s = b.min + b.max + q;
+        if write {
+            *f = Aabb3::new(f.min + s, f.max + s);
+            moved.push(i as u32);
+        } else {
+            acc += f.min + f.max + s;
+        }
+    };
+    match active {
+        Some(ix) => ix.iter().for_each(|&i| visit(i as usize)),
+        None => (0..local.len()).for_each(visit),
+    }
+    acc
+}
+
+fn bench(c: &mut Criterion) {
+    eprintln!("best backend: {:?}", Backend::detect());
+    let s = class_scene(N, 0xb70ad);
+    let (local, poses) = (&s.boxes, &s.rigid);
+    let jumped: Vec<Rigid3> = poses
+        .iter()
+        .map(|p| Rigid3::new(p.rotation, p.translation + Vec3A::X * 10.0))
+        .collect();
+    let margin = Margin::new(0.1, 0.1);
+    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+    let mut r = Xorshift(0xac7);
+    for (percent, label) in [(1, "1%"), (10, "10%"), (100, "100%")] {
+        let indices: Vec<u32> = (0..N as u32)
+            .filter(|_| r.next_f32() * 100.0 < percent as f32)
+            .collect();
+        let (active, subset) = if percent == 100 {
+            (Active::All, None)
+        } else {
+            (Active::Indices(&indices), Some(&indices[..]))
+        };
+        let count = subset.map_or(N, <[u32]>::len);
+        let mut g = c.benchmark_group(format!("broadphase/{label}"));
+        configure(&mut g, N);
+        g.throughput(Throughput::Elements(count as u64));
+
+        let mut fat = vec![Aabb3::EMPTY; N];
+        let mut moved = Moved::new();
+        let mut indices_out = Vec::with_capacity(N);
+        batch
+            .update(margin, Active::All, local, poses, &mut fat, &mut moved)
+            .unwrap();
+        g.bench_function("update/stay", |b| {
+            b.iter(|| {
+                batch
+                    .update(
+                        margin,
+                        active,
+                        black_box(local),
+                        poses,
+                        &mut fat,
+                        &mut moved,
+                    )
+                    .unwrap();
+                assert!(moved.is_empty());
+            })
+        });
+        g.bench_function("roofline/stay", |b| {
+            b.iter(|| {
+                roofline(
+                    subset,
+                    black_box(local),
+                    poses,
+                    &mut fat,
+                    false,
+                    &mut indices_out,
+                )
+            })
+        });
+        let mut flip = false;
+        g.bench_function("update/moved", |b| {
+            b.iter(|| {
+                flip = !flip;
+                let poses = if flip { &jumped } else { poses };
+                batch
+                    .update(
+                        margin,
+                        active,
+                        black_box(local),
+                        poses,
+                        &mut fat,
+                        &mut moved,
+                    )
+                    .unwrap();
+                assert_eq!(moved.len(), count);
+            })
+        });
+        g.bench_function("roofline/moved", |b| {
+            b.iter(|| {
+                roofline(
+                    subset,
+                    black_box(local),
+                    poses,
+                    &mut fat,
+                    true,
+                    &mut indices_out,
+                )
+            })
+        });
+        if percent == 100 {
+            // What a broadphase without fat boxes does: every tight box, every frame.
+            let mut world = vec![Aabb3::EMPTY; N];
+            g.bench_function("naive/transform", |b| {
+                b.iter(|| {
+                    batch
+                        .transform(black_box(local), poses, &mut world)
+                        .unwrap()
+                })
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
