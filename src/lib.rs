@@ -87,7 +87,7 @@ pub mod tree;
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
 pub use error::TransformError;
-pub use fit::{Capsule, Fit, FitError, Obb3, Sphere};
+pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};
 pub use method::{Method, Rounding};
 pub use simd::Backend;
 pub use transform::{
