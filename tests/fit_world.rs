@@ -654,3 +654,351 @@ world_tests! {
     capsule_trs: Capsule, Trs3, 14;
     capsule_affine: Capsule, Affine3A, 15;
 }
+
+// ---------------------------------------------------------------- batches and bad input
+
+/// Bit patterns of a box, so that NaN results compare too.
+fn bits(b: &Aabb3) -> [u32; 6] {
+    let (l, h) = (b.min.to_array(), b.max.to_array());
+    [l[0], l[1], l[2], h[0], h[1], h[2]].map(f32::to_bits)
+}
+
+/// The batch entry point equals the single calls bitwise, per transform and shared, and
+/// checks its lengths before writing anything.
+fn batch_matches<V: Volume, T: Case>(seed: u64) {
+    let mut r = rng(seed);
+    let (mut volumes, mut xfs) = (Vec::new(), Vec::new());
+    for class in Class::ALL {
+        for _ in 0..3 {
+            let (xf, _, lo, hi) = T::make(class, &mut r);
+            volumes.push(V::from_box(lo, hi, &mut r));
+            xfs.push(xf);
+        }
+    }
+    let n = volumes.len();
+    let sentinel = Aabb3::new(Vec3A::splat(7.0), Vec3A::splat(-7.0));
+    for rounding in Rounding::ALL {
+        let mut out = vec![sentinel; n];
+        V::transformed_aabbs(&volumes, &xfs[..], &mut out, rounding).unwrap();
+        let mut shared = vec![sentinel; n];
+        V::transformed_aabbs(&volumes, &xfs[5], &mut shared, rounding).unwrap();
+        for k in 0..n {
+            assert_eq!(
+                bits(&out[k]),
+                bits(&volumes[k].transformed_aabb(&xfs[k], rounding))
+            );
+            assert_eq!(
+                bits(&shared[k]),
+                bits(&volumes[k].transformed_aabb(&xfs[5], rounding))
+            );
+        }
+        let mut short = vec![sentinel; n - 1];
+        assert_eq!(
+            V::transformed_aabbs(&volumes, &xfs[..], &mut short, rounding),
+            Err(BatchError::LengthMismatch {
+                what: "output",
+                expected: n,
+                found: n - 1
+            })
+        );
+        let mut untouched = vec![sentinel; n];
+        assert_eq!(
+            V::transformed_aabbs(&volumes, &xfs[1..], &mut untouched, rounding),
+            Err(BatchError::LengthMismatch {
+                what: "transforms",
+                expected: n,
+                found: n - 1
+            })
+        );
+        assert!(short.iter().chain(&untouched).all(|b| *b == sentinel));
+    }
+}
+
+#[test]
+fn batches_equal_single_calls() {
+    batch_matches::<Obb3, Rigid3>(21);
+    batch_matches::<Obb3, Affine3A>(22);
+    batch_matches::<Sphere, Translation3>(23);
+    batch_matches::<Sphere, Similarity3>(24);
+    batch_matches::<Capsule, Trs3>(25);
+    batch_matches::<Capsule, Affine3A>(26);
+}
+
+#[test]
+fn bad_input_follows_the_contract() {
+    let pose = Rigid3::new(Quat::from_rotation_z(0.5), Vec3A::new(1.0, 2.0, 3.0));
+    let obb = Obb3 {
+        center: Vec3A::ONE,
+        half_extents: Vec3A::new(1.0, 2.0, 3.0),
+        rotation: Mat3A::from_rotation_x(0.3),
+    };
+    let sphere = Sphere {
+        center: Vec3A::ONE,
+        radius: 2.0,
+    };
+    let capsule = Capsule {
+        a: Vec3A::ZERO,
+        b: Vec3A::X,
+        radius: 1.0,
+    };
+    let everywhere = Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+    let nan_pose = Rigid3::new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3A::ZERO);
+    let inf_pose = Affine3A::from_translation(glam::Vec3::new(f32::INFINITY, 0.0, 0.0));
+    for rounding in Rounding::ALL {
+        for v in [obb] {
+            assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
+            assert!(!v.transformed_aabb(&inf_pose, rounding).is_valid());
+            let nan = Obb3 {
+                center: Vec3A::new(0.0, f32::NAN, 0.0),
+                ..v
+            };
+            assert!(!nan.transformed_aabb(&pose, rounding).is_valid());
+            let empty = Obb3 {
+                half_extents: Vec3A::new(1.0, -1.0, 1.0),
+                ..v
+            };
+            assert_eq!(empty.transformed_aabb(&pose, rounding), Aabb3::EMPTY);
+            let unbounded = Obb3 {
+                half_extents: Vec3A::new(1.0, f32::INFINITY, 1.0),
+                ..v
+            };
+            assert_eq!(unbounded.transformed_aabb(&pose, rounding), everywhere);
+            let singular = Obb3 {
+                rotation: Mat3A::ZERO,
+                ..v
+            };
+            assert_eq!(singular.transformed_aabb(&pose, rounding), everywhere);
+        }
+        for v in [sphere] {
+            assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
+            assert!(!v.transformed_aabb(&inf_pose, rounding).is_valid());
+            let nan = Sphere {
+                radius: f32::NAN,
+                ..v
+            };
+            assert!(!nan.transformed_aabb(&pose, rounding).is_valid());
+            let empty = Sphere { radius: -1.0, ..v };
+            assert_eq!(empty.transformed_aabb(&pose, rounding), Aabb3::EMPTY);
+            let far = Sphere {
+                center: Vec3A::splat(3e38),
+                radius: 1e38,
+            };
+            // Faces at 2e39 and 4e39: +inf, or f32::MAX for an Outward lower face.
+            let big = Similarity3::new(10.0, Quat::IDENTITY, Vec3A::ZERO);
+            let b = far.transformed_aabb(&big, rounding);
+            assert_eq!(b.max, Vec3A::INFINITY);
+            assert!(b.min.cmpge(Vec3A::splat(f32::MAX)).all(), "{b:?}");
+        }
+        for v in [capsule] {
+            assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
+            let nan = Capsule { b: Vec3A::NAN, ..v };
+            assert!(!nan.transformed_aabb(&pose, rounding).is_valid());
+            let empty = Capsule { radius: -0.5, ..v };
+            assert_eq!(empty.transformed_aabb(&pose, rounding), Aabb3::EMPTY);
+            let unbounded = Capsule {
+                a: Vec3A::NEG_INFINITY,
+                ..v
+            };
+            assert_eq!(unbounded.transformed_aabb(&pose, rounding), everywhere);
+        }
+    }
+}
+
+// ---------------------------------------------------------------- images under similarities
+
+/// Rational directions on the unit sphere: the axes and `(1, 2, 2)/3`, `(2, 3, 6)/7`,
+/// `(1, 4, 8)/9` with every sign and cyclic order.
+fn unit_directions() -> Vec<V3> {
+    let mut dirs = Vec::new();
+    for k in 0..3 {
+        for s in [-1, 1] {
+            let mut v = [0i64; 3];
+            v[k] = s;
+            dirs.push(v.map(Q::int));
+        }
+    }
+    for ([a, b, c], m) in [([1, 2, 2], 3), ([2, 3, 6], 7), ([1, 4, 8], 9)] {
+        for rot in 0..3 {
+            for signs in 0..8 {
+                let base = [a, b, c];
+                let v: [i64; 3] = core::array::from_fn(|i| {
+                    let x = base[(i + rot) % 3];
+                    if signs >> i & 1 == 1 { -x } else { x }
+                });
+                dirs.push(v.map(|x| Q::int(x).div(&Q::int(m))));
+            }
+        }
+    }
+    dirs
+}
+
+/// `|x − c|² <= r²`, exactly.
+fn in_ball(x: &V3, c: Vec3A, r: f32) -> bool {
+    let d = vsub(x, &v3(c));
+    let r = Q::f(r);
+    dot(&d, &d).le(&r.mul(&r))
+}
+
+/// The capsule's statement on `x`, exactly.
+fn in_capsule(x: &V3, cap: &Capsule) -> bool {
+    let (a, b) = (v3(cap.a), v3(cap.b));
+    let r = Q::f(cap.radius);
+    let r2 = r.mul(&r);
+    let (v, w) = (vsub(x, &a), vsub(&b, &a));
+    let (vw, ww) = (dot(&v, &w), dot(&w, &w));
+    if vw.le(&Q::int(0)) || ww.le(&Q::int(0)) {
+        dot(&v, &v).le(&r2)
+    } else if ww.le(&vw) {
+        let u = vsub(x, &b);
+        dot(&u, &u).le(&r2)
+    } else {
+        dot(&v, &v).mul(&ww).sub(&vw.mul(&vw)).le(&r2.mul(&ww))
+    }
+}
+
+/// The box's slab statement on `x`, exactly.
+fn in_box(x: &V3, obb: &Obb3) -> bool {
+    let d = vsub(x, &v3(obb.center));
+    (0..3).all(|k| {
+        let s = dot(&d, &v3(obb.rotation.col(k)));
+        let h = Q::f(obb.half_extents[k]);
+        s.le(&h) && s.neg().le(&h)
+    })
+}
+
+/// A similarity (`Rigid3` when `rigid`) of an extreme class, its exact map (`None` when
+/// non-finite), `|σ|` and a box of the class.
+fn similarity(
+    class: Class,
+    rigid: bool,
+    r: &mut StdRng,
+) -> (Similarity3, Option<XMap>, Vec3A, Vec3A) {
+    let scale = if rigid { Scale::Unit } else { Scale::Uniform };
+    let (p, map, lo, hi) = quat_case(class, scale, r);
+    let xf = if rigid {
+        p.rigid3().into()
+    } else {
+        p.similarity3()
+    };
+    (xf, map, lo, hi)
+}
+
+fn finite(values: &[f32]) -> bool {
+    values.iter().all(|x| x.is_finite())
+}
+
+/// Every image holds the exact images of the volume's extreme points (the box's corners,
+/// points of the balls' spheres), over every extreme class, rigid and similar.
+#[test]
+fn images_hold_the_exact_images() {
+    let mut r = rng(31);
+    let dirs = unit_directions();
+    let mut checked = 0;
+    for class in Class::ALL {
+        for n in 0..CASES_PER_CLASS {
+            for rigid in [true, false] {
+                let (xf, map, lo, hi) = similarity(class, rigid, &mut r);
+                let (obb, sphere, capsule) = (
+                    Obb3::from_box(lo, hi, &mut r),
+                    Sphere::from_box(lo, hi, &mut r),
+                    Capsule::from_box(lo, hi, &mut r),
+                );
+                let context = format!("{class:?} #{n} rigid {rigid}: {xf:?}");
+                let images = (
+                    obb.transformed(xf),
+                    sphere.transformed(xf),
+                    capsule.transformed(xf),
+                );
+                let Some(map) = map.filter(|_| finite(&obb.fields()) && finite(&capsule.fields()))
+                else {
+                    // NaN or infinite input: NaN fields (or the empty volume's sign kept).
+                    assert!(images.0.fields().iter().any(|x| x.is_nan()), "{context}");
+                    continue;
+                };
+                let (o, s, c) = images;
+                if finite(&o.fields()) && !obb.is_empty() {
+                    for y in corners(&obb) {
+                        assert!(
+                            in_box(&map.apply(&y), &o),
+                            "box {obb:?} -> {o:?}, {context}"
+                        );
+                    }
+                    checked += 1;
+                }
+                assert_eq!(o.is_empty(), obb.is_empty(), "{context}");
+                let rad = Q::f(sphere.radius);
+                if finite(&s.fields()) && !sphere.is_empty() {
+                    for d in &dirs {
+                        let y = vadd(&v3(sphere.center), &vscale(d, &rad));
+                        assert!(
+                            in_ball(&map.apply(&y), s.center, s.radius),
+                            "ball {sphere:?} -> {s:?}, {context}"
+                        );
+                    }
+                    checked += 1;
+                }
+                assert_eq!(s.is_empty(), sphere.is_empty(), "{context}");
+                let rad = Q::f(capsule.radius);
+                let mid = vscale(
+                    &vadd(&v3(capsule.a), &v3(capsule.b)),
+                    &Q::int(1).div(&Q::int(2)),
+                );
+                if finite(&c.fields()) && !capsule.is_empty() {
+                    for p in [v3(capsule.a), v3(capsule.b), mid] {
+                        for d in &dirs[..30] {
+                            let y = vadd(&p, &vscale(d, &rad));
+                            assert!(
+                                in_capsule(&map.apply(&y), &c),
+                                "capsule {capsule:?} -> {c:?}, {context}"
+                            );
+                        }
+                    }
+                    checked += 1;
+                }
+                assert_eq!(c.is_empty(), capsule.is_empty(), "{context}");
+            }
+        }
+    }
+    assert!(checked > 600, "only {checked} finite images checked");
+}
+
+/// For unit quaternions and orthonormal axes the images are tight: the half-extents and
+/// radii exceed `|σ|` times the old ones by about the rounding of the moved center.
+#[test]
+fn images_are_tight() {
+    let mut r = rng(32);
+    for class in [
+        Class::Typical,
+        Class::Far,
+        Class::Reflection,
+        Class::ZeroSize,
+    ] {
+        for _ in 0..50 {
+            let (xf, _, lo, hi) = similarity(class, false, &mut r);
+            let sigma = xf.scale.abs();
+            let slack = |c: Vec3A, size: f32| {
+                2f32.powi(-18) * (c.abs().element_sum() + sigma * size) + 1e-30
+            };
+            let obb = Obb3::from_box(lo, hi, &mut r);
+            let o = obb.transformed(xf);
+            for k in 0..3 {
+                let bound =
+                    sigma * obb.half_extents[k] + slack(o.center, obb.half_extents.element_sum());
+                assert!(o.half_extents[k] <= bound, "{obb:?} -> {o:?} under {xf:?}");
+            }
+            let sphere = Sphere::from_box(lo, hi, &mut r);
+            let s = sphere.transformed(xf);
+            assert!(
+                s.radius <= sigma * sphere.radius + slack(s.center, sphere.radius),
+                "{s:?}"
+            );
+            let capsule = Capsule::from_box(lo, hi, &mut r);
+            let c = capsule.transformed(xf);
+            let reach = c.a.abs().max(c.b.abs());
+            assert!(
+                c.radius <= sigma * capsule.radius + slack(reach, capsule.radius),
+                "{c:?}"
+            );
+        }
+    }
+}
