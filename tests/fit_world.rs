@@ -230,6 +230,9 @@ impl Candidate {
     }
 }
 
+/// A volume's exact faces: the candidates of the lower and upper faces, `reach` and `κ`.
+type Faces = ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64);
+
 /// What the contract demands of one volume's world AABB.
 enum Expected {
     Invalid,
@@ -249,7 +252,7 @@ trait Volume: BoundingVolume + Copy + core::fmt::Debug {
     fn fields(&self) -> Vec<f32>;
     fn is_empty(&self) -> bool;
     /// The exact faces' candidates (finite fields, non-empty), `reach` and `κ`.
-    fn faces(&self, map: &XMap) -> ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64);
+    fn faces(&self, map: &XMap) -> Faces;
     /// A volume built from a problem's box.
     fn from_box(lo: Vec3A, hi: Vec3A, r: &mut StdRng) -> Self;
 
@@ -325,7 +328,7 @@ impl Volume for Obb3 {
     fn is_empty(&self) -> bool {
         self.half_extents.min_element() < 0.0
     }
-    fn faces(&self, map: &XMap) -> ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64) {
+    fn faces(&self, map: &XMap) -> Faces {
         let images: Vec<V3> = corners(self).iter().map(|y| map.apply(y)).collect();
         let axis = |i: usize| -> Vec<Candidate> {
             images
@@ -359,11 +362,7 @@ impl Volume for Obb3 {
 }
 
 /// The candidates of balls of radius `r` about `ends`.
-fn swept(
-    map: &XMap,
-    ends: &[Vec3A],
-    radius: f32,
-) -> ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64) {
+fn swept(map: &XMap, ends: &[Vec3A], radius: f32) -> Faces {
     let r = Q::f(radius);
     let norm2 = |i: usize| dot(&map.rows[i], &map.rows[i]);
     let side = |sign: &Q| {
@@ -393,7 +392,7 @@ impl Volume for Sphere {
     fn is_empty(&self) -> bool {
         self.radius < 0.0
     }
-    fn faces(&self, map: &XMap) -> ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64) {
+    fn faces(&self, map: &XMap) -> Faces {
         swept(map, &[self.center], self.radius)
     }
     fn from_box(lo: Vec3A, hi: Vec3A, _: &mut StdRng) -> Self {
@@ -414,7 +413,7 @@ impl Volume for Capsule {
     fn is_empty(&self) -> bool {
         self.radius < 0.0
     }
-    fn faces(&self, map: &XMap) -> ([Vec<Candidate>; 3], [Vec<Candidate>; 3], [f64; 3], f64) {
+    fn faces(&self, map: &XMap) -> Faces {
         swept(map, &[self.a, self.b], self.radius)
     }
     fn from_box(lo: Vec3A, hi: Vec3A, _: &mut StdRng) -> Self {
@@ -745,7 +744,8 @@ fn bad_input_follows_the_contract() {
     let nan_pose = Rigid3::new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3A::ZERO);
     let inf_pose = Affine3A::from_translation(glam::Vec3::new(f32::INFINITY, 0.0, 0.0));
     for rounding in Rounding::ALL {
-        for v in [obb] {
+        {
+            let v = obb;
             assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
             assert!(!v.transformed_aabb(&inf_pose, rounding).is_valid());
             let nan = Obb3 {
@@ -769,7 +769,8 @@ fn bad_input_follows_the_contract() {
             };
             assert_eq!(singular.transformed_aabb(&pose, rounding), everywhere);
         }
-        for v in [sphere] {
+        {
+            let v = sphere;
             assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
             assert!(!v.transformed_aabb(&inf_pose, rounding).is_valid());
             let nan = Sphere {
@@ -789,7 +790,8 @@ fn bad_input_follows_the_contract() {
             assert_eq!(b.max, Vec3A::INFINITY);
             assert!(b.min.cmpge(Vec3A::splat(f32::MAX)).all(), "{b:?}");
         }
-        for v in [capsule] {
+        {
+            let v = capsule;
             assert!(!v.transformed_aabb(&nan_pose, rounding).is_valid());
             let nan = Capsule { b: Vec3A::NAN, ..v };
             assert!(!nan.transformed_aabb(&pose, rounding).is_valid());

@@ -111,9 +111,10 @@ fn dual(rotation: Mat3A) -> Option<(DMat3, f64, f64)> {
     (kappa < MAX_KAPPA).then_some((b, det, kappa))
 }
 
-/// `max(1, 2‖q‖² − 1)`, which bounds the spectral norm of `R(q)` for any `q`: the formula is
-/// `R(q) = ‖q‖²·Q + (1 − ‖q‖²)·I` with `Q` the rotation of `q/‖q‖`. Computed within
-/// `γ(7)` relative (`‖q‖²` to `γ(3)`, doubled against `2‖q‖² − 1 >= ‖q‖²`, one subtraction).
+/// `|σ|·max(1, 2‖q‖² − 1)`, which bounds the spectral norm of `σ·R(q)` for any `q`: the
+/// formula is `R(q) = ‖q‖²·Q + (1 − ‖q‖²)·I` with `Q` the rotation of `q/‖q‖`. Computed
+/// within `γ(8)` relative (`‖q‖²` to `γ(3)`, doubled against `2‖q‖² − 1 >= ‖q‖²`, the
+/// subtraction, the product with `|σ|`).
 fn stretch(xf: &Similarity3) -> f64 {
     let n = xf.rotation.as_dquat().length_squared();
     (2.0 * n - 1.0).max(1.0) * f64::from(xf.scale).abs()
@@ -135,8 +136,8 @@ pub(crate) trait Shape {
 /// - [`Rounding::Nearest`] rounds the same `f64` evaluation to nearest: within
 ///   `u·|x_i| + 2^-44·(1 + κ)·S_i + 2^-150`.
 ///
-/// Here `u = 2^-24`, `κ` is 1 for spheres and capsules and the conditioning of a box's axes
-/// (1 when orthonormal, see the [module docs](self)), and
+/// Here `u = 2^-24`, `κ` is 1 for spheres and capsules and for a box the conditioning
+/// `κ = Σ_l |a_0l·B_0l| / |a_0·B_0|` of its axes, `B_0 = a_1 × a_2` (1 when orthonormal), and
 /// `S_i = |t_i| + Σ_k μ_ik·reach_k` with `μ_ik = |m_ik|` for an affine map (the identity
 /// for a translation) and `ρ·|s_k|` for a quaternion class, as in [`crate::transform`];
 /// `reach_k` is `|c_k| + Σ_j |b_jk|·h_j` for a box (`b_j` its dual basis, its axes when
@@ -150,6 +151,25 @@ pub(crate) trait Shape {
 /// no finite set and gives the whole space; faces beyond the `f32` range are `±inf`. The
 /// evaluation is one `f64` form per volume (there is no choice of [`crate::Method`]), and
 /// nothing panics.
+///
+/// ```
+/// use bvkit::{Aabb3, BoundingVolume, Fit, Obb3, Rigid3, Rounding, Sphere};
+/// use glam::{Quat, Vec3, Vec3A};
+///
+/// let points = [Vec3::ZERO, Vec3::X, Vec3::new(0.0, 2.0, 1.0)];
+/// let obb = Obb3::fit(&points, Fit::Fast)?;
+/// let pose = Rigid3::new(Quat::from_rotation_y(0.7), Vec3A::new(5.0, 0.0, 0.0));
+/// // The origin is a fitted point, and maps exactly to the translation.
+/// assert!(obb.transformed_aabb(&pose, Rounding::Outward).contains_point(pose.translation));
+/// assert!(obb.transformed(pose).contains_point(pose.translation));
+///
+/// // Many at once: one transform per volume, or one shared (`&pose`).
+/// let balls = vec![Sphere::fit(&points, Fit::Tight)?; 4];
+/// let mut world = vec![Aabb3::EMPTY; 4];
+/// Sphere::transformed_aabbs(&balls, &pose, &mut world, Rounding::Outward)?;
+/// assert_eq!(world[3], balls[3].transformed_aabb(&pose, Rounding::Outward));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub trait BoundingVolume: Shape + Sized {
     /// The AABB of the volume's image under `xf` (see the [trait docs](BoundingVolume)).
     #[inline]
@@ -212,16 +232,19 @@ impl Obb3 {
     /// The center is `σ·R(q)·c + t` and the axes `R(q)·a_k`, each rounded to nearest (the
     /// axes stay orthonormal to within `f32` rounding for a unit `q`; a reflection `σ < 0`
     /// only flips every slab, which changes nothing). Each half-extent is the support of the
-    /// image on its new axis: `h'_k = |(M c + t − c')·a'_k| + Σ_j h_j·|a'_k·(M B_j)|/|D|`,
-    /// `M = σ·R(q)`, `B_j`, `D` the dual basis (module docs). Its `f64` value rounds at
-    /// most 12 times (the cross product, `M·B`, the dot with `a'_k`, `·h`, the sum, `/D`,
-    /// the sum with the center term of 9 roundings), and `D` is within `γ(4)·κ`, so the
-    /// lemma with scale `2·(1 + κ)·|a'_k|·(|c'| + magnitude(reach))` certifies it (module
-    /// docs). For a unit `q` and orthonormal axes `h'_k` exceeds `|σ|·h_k` by about the
-    /// rounding of the center. NaN or an infinite field gives NaN fields; an empty box
-    /// stays empty; singular axes give infinite half-extents.
+    /// exact image on its new axis, rounded up: for a unit `q` and orthonormal axes it
+    /// exceeds `|σ|·h_k` by about the rounding of the center. NaN or an infinite field
+    /// gives NaN fields; an empty box stays empty; singular axes give infinite
+    /// half-extents.
     #[must_use]
     pub fn transformed(&self, xf: impl Into<Similarity3>) -> Self {
+        // With `M = σ·R(q)` and the dual basis `B_j`, `D` (module docs), the image is
+        // `M c + t + Σ_j s_j·M B_j/D`, `|s_j| <= h_j`: on axis `a'_k` about `c'` it reaches
+        // `h'_k = |(M c + t − c')·a'_k| + Σ_j h_j·|a'_k·(M B_j)|/|D|`. Its `f64` value
+        // rounds at most 12 times (the cross product, `M·B`, the dot with `a'_k`, `·h`, the
+        // sum, `/D`, the sum with the center term of 9 roundings) and `D` is within
+        // `γ(4)·κ`: the lemma with scale `2·(1 + κ)·|a'_k|·(|c'| + magnitude(reach))`
+        // certifies it (module docs).
         let xf = xf.into();
         let (Some(map), true) = (Map::of(&xf), self.is_finite()) else {
             return Self {
@@ -349,8 +372,8 @@ impl Shape for Capsule {
 }
 
 /// The radius of a swept volume's image: `stretch·r` plus the largest shift of a moved
-/// point, bounded. The stretch rounds up to 9 times with `r` and the sum, so its term
-/// enters the scale too, doubled with the shifts' scales (module docs).
+/// point, bounded. The swept term rounds up to 10 times (the stretch's 8, `·r`, the sum),
+/// so it enters the scale too, doubled with the shifts' scales (module docs).
 fn image_radius(xf: &Similarity3, radius: f32, shifts: &[Bounded]) -> f32 {
     let swept = stretch(xf) * f64::from(radius);
     let shift = shifts.iter().map(|s| s.value).fold(0.0, f64::max);
