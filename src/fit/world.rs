@@ -5,7 +5,10 @@
 //! **The map in `f64`.** Every class is read as `x ↦ M x + t` through its extended-range
 //! form: an affine matrix exactly, a quaternion class's `R(q)·diag(s)` within
 //! `ε_k = 2^-50·ρ·|s_k|` on each entry of column `k` (`ρ = 1 + 2‖q‖²`). Products of the
-//! `f32` inputs never underflow or overflow in `f64`, so every rounding is relative. Each
+//! `f32` inputs never overflow in `f64`, and every rounding is relative but for an operation
+//! whose result falls below `f64`'s normal range (only when several inputs lie near the
+//! bottom of `f32`'s subnormal range at once): it errs by at most `2^-1075`, which the
+//! absolute term `2^-1000` of every scale covers ([`certified`]). Each
 //! face (or radius, or half-extent) is then one `f64` expression on exact data whose error
 //! the [`bound`](super::bound) lemma turns into an outward `f32`: an absolute error `ε·x`
 //! enters its scale as `2^50·ε·x` (`γ(8)·2^50 >= 1`), and an expression of up to 12
@@ -82,9 +85,19 @@ impl Map {
     }
 }
 
+/// The lemma's bound on `value`, with `2^-1000` added to its `scale`: an ample cover for
+/// the absolute error, at most `2^-1075` each, of the operations that underflow in `f64`.
+fn certified(value: f64, scale: f64) -> Bounded {
+    const TINY_SCALE: f64 = f64::from_bits(23 << 52); // 2^(23 − 1023)
+    Bounded {
+        value,
+        scale: scale + TINY_SCALE,
+    }
+}
+
 /// An `f32` face from an `f64` value bounded by the lemma: rounded to nearest, or outward.
 fn face(value: f64, scale: f64, rounding: Rounding, lower: bool) -> f32 {
-    let bounded = Bounded { value, scale };
+    let bounded = certified(value, scale);
     match (rounding, lower) {
         (Rounding::Nearest, _) => value as f32,
         (Rounding::Outward, true) => bounded.lower(),
@@ -276,13 +289,7 @@ impl Obb3 {
                     (a2t * (map.m * b)).abs() * h / det + (a2t * (map.apply(c) - c2)).abs();
                 let reach = c.abs() + b.abs() * h / det;
                 let scale = a2t.abs() * (map.magnitude(reach) + c2.abs()) * (2.0 * (1.0 + kappa));
-                Vec3A::from_array([0, 1, 2].map(|k| {
-                    Bounded {
-                        value: support[k],
-                        scale: scale[k],
-                    }
-                    .upper()
-                }))
+                Vec3A::from_array([0, 1, 2].map(|k| certified(support[k], scale[k]).upper()))
             }
         };
         Self {
@@ -378,11 +385,7 @@ fn image_radius(xf: &Similarity3, radius: f32, shifts: &[Bounded]) -> f32 {
     let swept = stretch(xf) * f64::from(radius);
     let shift = shifts.iter().map(|s| s.value).fold(0.0, f64::max);
     let scale: f64 = shifts.iter().map(|s| s.scale).sum();
-    Bounded {
-        value: swept + shift,
-        scale: 2.0 * (swept + scale),
-    }
-    .upper()
+    certified(swept + shift, 2.0 * (swept + scale)).upper()
 }
 
 impl Sphere {
