@@ -89,7 +89,7 @@ pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
 pub use broadphase::{Active, LargeRigid3, Margin, Moved, Swept};
 pub use error::TransformError;
-pub use fit::{Capsule, Fit, FitError, Obb3, Sphere};
+pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};
 pub use method::{Method, Rounding};
 pub use simd::Backend;
 pub use transform::{

@@ -1,6 +1,7 @@
 //! Fitting bounding volumes to points: oriented boxes ([`Obb3`]), spheres ([`Sphere`]) and
 //! capsules ([`Capsule`]), from the PCA baseline ([`Fit::Pca`]) to tight fits
-//! ([`Fit::Tight`]).
+//! ([`Fit::Tight`]); and their world AABBs under any transform class ([`BoundingVolume`]),
+//! and their images under similarities (`Obb3::transformed`, …).
 //!
 //! **Containment.** Every fit computes in `f64` on the exact values of the `f32` inputs,
 //! rounds its result to `f32`, and then derives the extents (or radius) of that `f32`
@@ -22,10 +23,12 @@ mod obb;
 mod rect;
 mod search;
 mod sphere;
+mod world;
 
 pub use capsule::Capsule;
 pub use obb::Obb3;
 pub use sphere::Sphere;
+pub use world::BoundingVolume;
 
 use core::fmt;
 
