@@ -75,7 +75,7 @@ QUATS = {
 
 root = pathlib.Path("fuzz/seeds")
 TARGETS = ["affine3", "affine2", "rigid2", "mat4", "batch", "translation3", "translation2",
-           "rigid3", "similarity3", "trs3"]
+           "rigid3", "similarity3", "trs3", "update"]
 for target in TARGETS:
     (root / target).mkdir(parents=True, exist_ok=True)
 
@@ -96,6 +96,12 @@ for name, (cols, t, lo, hi) in classes3.items():
     (root / "rigid3" / name).write_bytes(data3 + quat)
     (root / "similarity3" / name).write_bytes(data3 + quat + f(scale[0]))
     (root / "trs3" / name).write_bytes(data3 + quat + b"".join(map(f, scale)))
+    # update: the problem and quaternion (current pose), the same again (predicted: a
+    # typical quaternion), then a fat box and a margin: a fat box around the origin and
+    # the margin (0.1, 0.5).
+    typical = b"".join(map(f, UNIT))
+    fat = b"".join(map(f, [-1.0, -1.0, -1.0, 1.0, 1.0, 1.0]))
+    (root / "update" / name).write_bytes(data3 + quat + data3 + typical + fat + f(0.1) + f(0.5))
     # batch: backend, method, rounding, class, n bytes, then n problems of the class
     # (0 affine, 2 rigid3, 5 affine 2D).
     (root / "batch" / name).write_bytes(bytes([0, 1, 1, 0, 9]) + data3 * 9)

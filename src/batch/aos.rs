@@ -43,6 +43,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         B::aabb3s(self)
     }
+    fn prefetch(&self, i: usize) {
+        crate::simd::prefetch(&self[i]);
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
@@ -111,6 +114,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Each(self))
     }
+    fn prefetch(&self, i: usize) {
+        crate::simd::prefetch(&self[i]);
+    }
 }
 
 /// One transform shared by every box (compound bodies, instanced props).
@@ -149,6 +155,9 @@ impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
     }
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         E::aabb3s(self.as_slice())
+    }
+    fn prefetch(&self, i: usize) {
+        crate::simd::prefetch(&self[i]);
     }
 }
 
@@ -205,5 +214,8 @@ impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
     }
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {
         Some(Maps::Each(self.as_slice()))
+    }
+    fn prefetch(&self, i: usize) {
+        crate::simd::prefetch(&self[i]);
     }
 }

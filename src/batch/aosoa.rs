@@ -95,6 +95,14 @@ impl<T: Fields> Block8<T> {
         T::from_fields(&v)
     }
 
+    /// Asks for the cache lines of value `k` (one per field at most).
+    #[inline]
+    pub(crate) fn prefetch(&self, k: usize) {
+        for field in self.fields.as_ref() {
+            crate::simd::prefetch(&field[k]);
+        }
+    }
+
     /// Sets value `k` of the block.
     #[inline]
     pub fn set(&mut self, k: usize, value: T) {
@@ -163,6 +171,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         let (lo, hi) = box_lanes::<f32, N>(&self[i / 8].get(i % 8).to_fields());
         (lo.0, hi.0)
+    }
+    fn prefetch(&self, i: usize) {
+        self[i / 8].prefetch(i % 8);
     }
 }
 
@@ -248,6 +259,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     fn get(&self, i: usize) -> T {
         self[i / 8].get(i % 8)
     }
+    fn prefetch(&self, i: usize) {
+        self[i / 8].prefetch(i % 8);
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
@@ -260,6 +274,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.as_slice(), i)
+    }
+    fn prefetch(&self, i: usize) {
+        ReadBoxes::prefetch(&self.as_slice(), i);
     }
 }
 
@@ -310,6 +327,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
     }
     fn get(&self, i: usize) -> T {
         ReadMaps::get(&self.as_slice(), i)
+    }
+    fn prefetch(&self, i: usize) {
+        ReadMaps::prefetch(&self.as_slice(), i);
     }
 }
 

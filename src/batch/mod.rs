@@ -123,6 +123,10 @@ pub(crate) mod sealed {
         fn aabb3s(&self) -> Option<&[Aabb3]> {
             None
         }
+        /// Asks for box `i`'s cache lines ahead of a scattered access.
+        fn prefetch(&self, i: usize) {
+            let _ = i;
+        }
     }
 
     /// Boxes to write.
@@ -176,6 +180,10 @@ pub(crate) mod sealed {
         /// The transforms as an AoS slice or one shared transform, when they are.
         fn maps(&self) -> Option<Maps<'_, Self::Class>> {
             None
+        }
+        /// Asks for transform `i`'s cache lines ahead of a scattered access.
+        fn prefetch(&self, i: usize) {
+            let _ = i;
         }
     }
 }

@@ -206,6 +206,13 @@ fn split_columns<'p, T: Fields>(
         .collect()
 }
 
+/// Asks for entry `i` of every column.
+fn prefetch_columns(columns: &[&[f32]], i: usize) {
+    for column in columns {
+        crate::simd::prefetch(&column[i]);
+    }
+}
+
 /// Lanes `i..i + count` of every column: one vector load per column for a whole lane
 /// block, lane by lane for the tail.
 #[inline(always)]
@@ -249,6 +256,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
             core::array::from_fn(|a| c[a][i]),
             core::array::from_fn(|a| c[N + a][i]),
         )
+    }
+    fn prefetch(&self, i: usize) {
+        prefetch_columns(self.columns.as_ref(), i);
     }
 }
 
@@ -336,6 +346,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
         }
         T::from_fields(&v)
     }
+    fn prefetch(&self, i: usize) {
+        prefetch_columns(self.columns.as_ref(), i);
+    }
 }
 
 impl<'a, const N: usize, E: Fields> ReadBoxes<N> for &'a Soa<E>
@@ -351,6 +364,9 @@ where
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.view(), i)
+    }
+    fn prefetch(&self, i: usize) {
+        ReadBoxes::prefetch(&self.view(), i);
     }
 }
 
@@ -411,5 +427,8 @@ where
     }
     fn get(&self, i: usize) -> Self::Class {
         ReadMaps::get(&self.view(), i)
+    }
+    fn prefetch(&self, i: usize) {
+        ReadMaps::prefetch(&self.view(), i);
     }
 }

@@ -134,6 +134,10 @@ pub(crate) mod sealed {
             method: Method,
             rounding: Rounding,
         ) -> [[f32; N]; 2];
+        /// Asks for object `i`'s poses ahead of a scattered access.
+        fn prefetch(&self, i: usize) {
+            let _ = i;
+        }
         /// Runs an update of AoS 3D boxes on the single-box kernel and returns true, or
         /// returns false where these poses or the backend have none.
         fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
@@ -179,6 +183,9 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
         let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
         [min, max]
     }
+    fn prefetch(&self, i: usize) {
+        ReadMaps::prefetch(self, i);
+    }
     fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
         match self.maps() {
             Some(maps) => X::Class::run_simd3(AosUpdateOn { maps, update }, backend),
@@ -191,6 +198,10 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         self.current.check_len(len)?;
         self.predicted.check_len(len)
+    }
+    fn prefetch(&self, i: usize) {
+        self.current.prefetch(i);
+        self.predicted.prefetch(i);
     }
     /// The union of the two boxes; a lane that does not stand at either pose does not
     /// stand (so that a NaN at one pose is never hidden by the other's box).
@@ -244,6 +255,9 @@ impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
                 found: self.poses.len(),
             })
         }
+    }
+    fn prefetch(&self, i: usize) {
+        simd::prefetch(&self.poses[i]);
     }
     /// One object at a time: the `f64` steps have no lane form.
     #[inline(always)]
@@ -424,30 +438,40 @@ impl<T: Transform3> AosUpdateOn<'_, T> {
             Maps::Each(poses) => &poses[i],
             Maps::Shared(pose) => pose,
         };
-        let mut object = |fat: &mut [Aabb3], i: usize| {
-            let tight = local[i].transformed(pose(i), method, rounding);
-            let f = &mut fat[i];
-            if !(f.min.cmple(tight.min).all() && tight.max.cmple(f.max).all()) {
-                *f = tight.fattened(margin);
+        let mut step = |local: &Aabb3, pose: &T, fat: &mut Aabb3, i: usize| {
+            let tight = local.transformed(pose, method, rounding);
+            if !(fat.min.cmple(tight.min).all() && tight.max.cmple(fat.max).all()) {
+                *fat = tight.fattened(margin);
                 moved.record(i, 1);
             }
         };
-        // Scattered objects: their lines are requested `AHEAD` objects in advance.
-        let ahead = |fat: &[Aabb3], i: usize| {
-            simd::prefetch(&local[i]);
-            simd::prefetch(&fat[i]);
-            simd::prefetch(pose(i));
-        };
-        match active {
-            Active::All => (0..local.len()).for_each(|i| object(fat, i)),
+        match (active, maps) {
+            // Every object: zipped, so that no index is checked.
+            (Active::All, Maps::Each(poses)) => {
+                let objects = local.iter().zip(poses).zip(fat.iter_mut());
+                for (i, ((l, p), f)) in objects.enumerate() {
+                    step(l, p, f, i);
+                }
+            }
+            (Active::All, Maps::Shared(p)) => {
+                for (i, (l, f)) in local.iter().zip(fat.iter_mut()).enumerate() {
+                    step(l, p, f, i);
+                }
+            }
+            // Scattered objects: their lines are requested `AHEAD` objects in advance.
             _ => {
+                let ahead = |fat: &[Aabb3], i: usize| {
+                    simd::prefetch(&local[i]);
+                    simd::prefetch(&fat[i]);
+                    simd::prefetch(pose(i));
+                };
                 let mut early = ActiveIndices::new(active);
                 early.by_ref().take(AHEAD).for_each(|i| ahead(fat, i));
                 for i in ActiveIndices::new(active) {
                     if let Some(j) = early.next() {
                         ahead(fat, j);
                     }
-                    object(fat, i);
+                    step(&local[i], pose(i), &mut fat[i], i);
                 }
             }
         }
@@ -566,7 +590,18 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
     /// the kernels are inlined twice per method, as in [`Batch::transform`]).
     #[inline(always)]
     fn visit<L: LaneArray>(&mut self, method: Method, outward: bool) {
+        // Scattered objects: their lines are requested `AHEAD` objects in advance.
+        let scattered = !matches!(self.active, Active::All);
+        let mut early = ActiveIndices::new(self.active);
+        early.by_ref().take(AHEAD).for_each(|i| self.prefetch(i));
         for (start, count, active) in Blocks::new(self.active, self.len, L::WIDTH) {
+            if scattered {
+                for _ in 0..active.count_ones() {
+                    if let Some(i) = early.next() {
+                        self.prefetch(i);
+                    }
+                }
+            }
             if count == L::WIDTH && active & (active - 1) != 0 {
                 self.block::<L>(start, L::WIDTH, active, method, outward);
             } else {
@@ -578,6 +613,14 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
                 }
             }
         }
+    }
+
+    /// Asks for object `i`'s local box, poses and fat box.
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        self.local.prefetch(i);
+        self.poses.prefetch(i);
+        self.fat.read().prefetch(i);
     }
 
     /// Objects `i..i + count`, of which the `lanes` bits are active: the tight boxes in

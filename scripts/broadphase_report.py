@@ -1,0 +1,36 @@
+#!/usr/bin/env python3
+"""Tabulates one `cargo bench --bench broadphase` run (criterion's JSON under
+target/criterion): per active fraction, ns per active object of the update and of the
+memory roofline of the same accesses, and their ratio, for the `stay` case (no fat box
+rewritten) and the `moved` case (every active fat box rewritten); and the naive path.
+Usage: python3 scripts/broadphase_report.py [target/criterion]
+"""
+import json
+import pathlib
+import sys
+
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/criterion")
+rows = {}  # (fraction, name) -> (ns per active object, total ms)
+for bench in root.glob("**/new/benchmark.json"):
+    meta = json.loads(bench.read_text())
+    group = meta["group_id"]
+    if not group.startswith("broadphase/"):
+        continue
+    fraction = group.split("/", 1)[1]
+    elements = meta["throughput"]["Elements"]
+    median = json.loads((bench.parent / "estimates.json").read_text())["median"]["point_estimate"]
+    rows[(fraction, meta["function_id"])] = (median / elements, median / 1e6)
+
+print("| active | case | AoS update ns/active | roofline ns/active | update / roofline | AoS ms per frame | AoSoA update ns/active |")
+print("|---|---|---:|---:|---:|---:|---:|")
+for fraction in ["1%", "10%", "100%"]:
+    for case in ["stay", "moved"]:
+        u = rows.get((fraction, f"update/{case}"))
+        r = rows.get((fraction, f"roofline/{case}"))
+        b = rows.get((fraction, f"update-aosoa/{case}"))
+        if u and r:
+            aosoa = f"{b[0]:.1f}" if b else "-"
+            print(f"| {fraction} | {case} | {u[0]:.1f} | {r[0]:.1f} | {u[0] / r[0]:.2f}x | {u[1]:.2f} | {aosoa} |")
+naive = rows.get(("100%", "naive/transform"))
+if naive:
+    print(f"\nnaive (every tight box rewritten, 1M objects): {naive[0]:.1f} ns per object, {naive[1]:.2f} ms per frame")
