@@ -438,40 +438,68 @@ impl<T: Transform3> AosUpdateOn<'_, T> {
             Maps::Each(poses) => &poses[i],
             Maps::Shared(pose) => pose,
         };
-        let mut step = |local: &Aabb3, pose: &T, fat: &mut Aabb3, i: usize| {
+        let step = |local: &Aabb3, pose: &T, fat: &mut Aabb3, i: usize, moved: &mut Moved| {
             let tight = local.transformed(pose, method, rounding);
             if !(fat.min.cmple(tight.min).all() && tight.max.cmple(fat.max).all()) {
                 *fat = tight.fattened(margin);
                 moved.record(i, 1);
             }
         };
-        match (active, maps) {
-            // Every object: zipped, so that no index is checked.
-            (Active::All, Maps::Each(poses)) => {
-                let objects = local.iter().zip(poses).zip(fat.iter_mut());
-                for (i, ((l, p), f)) in objects.enumerate() {
-                    step(l, p, f, i);
-                }
-            }
-            (Active::All, Maps::Shared(p)) => {
-                for (i, (l, f)) in local.iter().zip(fat.iter_mut()).enumerate() {
-                    step(l, p, f, i);
-                }
-            }
-            // Scattered objects: their lines are requested `AHEAD` objects in advance.
-            _ => {
-                let ahead = |fat: &[Aabb3], i: usize| {
-                    simd::prefetch(&local[i]);
-                    simd::prefetch(&fat[i]);
-                    simd::prefetch(pose(i));
-                };
-                let mut early = ActiveIndices::new(active);
-                early.by_ref().take(AHEAD).for_each(|i| ahead(fat, i));
-                for i in ActiveIndices::new(active) {
-                    if let Some(j) = early.next() {
-                        ahead(fat, j);
+        // Objects `start..end`, zipped so that no index is checked.
+        let run = |start: usize, end: usize, fat: &mut [Aabb3], moved: &mut Moved| {
+            let objects = local[start..end].iter().zip(&mut fat[start..end]);
+            match maps {
+                Maps::Each(poses) => {
+                    for (k, ((l, f), p)) in objects.zip(&poses[start..end]).enumerate() {
+                        step(l, p, f, start + k, moved);
                     }
-                    step(&local[i], pose(i), &mut fat[i], i);
+                }
+                Maps::Shared(p) => {
+                    for (k, (l, f)) in objects.enumerate() {
+                        step(l, p, f, start + k, moved);
+                    }
+                }
+            }
+        };
+        // Scattered objects: their lines are requested `AHEAD` objects in advance.
+        let ahead = |fat: &[Aabb3], i: usize| {
+            simd::prefetch(&local[i]);
+            simd::prefetch(&fat[i]);
+            simd::prefetch(pose(i));
+        };
+        let mut early = ActiveIndices::new(active);
+        early.by_ref().take(AHEAD).for_each(|i| ahead(fat, i));
+        let one = |i: usize, fat: &mut [Aabb3], moved: &mut Moved, early: &mut ActiveIndices| {
+            if let Some(j) = early.next() {
+                ahead(fat, j);
+            }
+            step(&local[i], pose(i), &mut fat[i], i, moved);
+        };
+        match active {
+            Active::All => run(0, local.len(), fat, moved),
+            Active::Indices(ix) => {
+                for &i in ix {
+                    one(i as usize, fat, moved, &mut early);
+                }
+            }
+            Active::Mask(words) => {
+                for (w, &word) in words.iter().enumerate() {
+                    if word == u64::MAX {
+                        // A run: the hardware prefetcher follows it; the lookahead skips it.
+                        run(64 * w, 64 * w + 64, fat, moved);
+                        early.nth(63);
+                        continue;
+                    }
+                    let mut bits = word;
+                    while bits != 0 {
+                        one(
+                            64 * w + bits.trailing_zeros() as usize,
+                            fat,
+                            moved,
+                            &mut early,
+                        );
+                        bits &= bits - 1;
+                    }
                 }
             }
         }
@@ -595,12 +623,16 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
         let mut early = ActiveIndices::new(self.active);
         early.by_ref().take(AHEAD).for_each(|i| self.prefetch(i));
         for (start, count, active) in Blocks::new(self.active, self.len, L::WIDTH) {
-            if scattered {
-                for _ in 0..active.count_ones() {
+            let ones = active.count_ones() as usize;
+            if scattered && ones < count {
+                for _ in 0..ones {
                     if let Some(i) = early.next() {
                         self.prefetch(i);
                     }
                 }
+            } else if scattered {
+                // A whole block: a run the hardware prefetcher follows; the lookahead skips it.
+                early.nth(ones - 1);
             }
             if count == L::WIDTH && active & (active - 1) != 0 {
                 self.block::<L>(start, L::WIDTH, active, method, outward);
