@@ -57,6 +57,12 @@
 //!   `NAN` box; unbounded faces to the exact unbounded result (a zero entry contributes
 //!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
 //!
+//! ## Broadphase
+//! [`broadphase`]: [`Batch::update`] rewrites only the fat boxes whose object left them and
+//! returns the [`Moved`] set, over [`Active`] subsets, with [`Swept`] pose pairs and
+//! large-world poses (`f64` positions, boxes relative to an `f64` origin, proven to contain
+//! the exact image).
+//!
 //! ## Trees
 //! [`tree`] keeps an AABB tree per object in its own frame ([`tree::TriMesh`],
 //! [`tree::AabbTree`]) and tests two objects at any pair of poses with one simultaneous

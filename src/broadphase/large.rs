@@ -1,18 +1,5 @@
-//! Large worlds: poses with an `f64` translation, and `f32` boxes relative to an `f64`
-//! origin the caller chooses, proven to contain the exact image.
-//!
-//! Engines that keep positions in `f64` (Jolt's double build, Box2D's large-world build,
-//! Unreal) add the position to the local box in `f64` with round-to-nearest and only then
-//! round to `f32` outward, so the double rounding can leave the box. Here nothing is
-//! rounded to nearest on the way: the rotated box comes from the `f32` Outward kernel, and
-//! every `f64` step is exact (an error-free sum) before one directed rounding to `f32`.
-//!
-//! **Bound.** Per face, the result exceeds the exact face by at most the Outward pad of the
-//! rotation (`(n + 2)·u·S + τ·TINY_PAD` with `S` the local magnitude, see
-//! [`crate::transform`]), plus one `f32` ulp of `t − origin` and two of the face; for
-//! `DAffine3`, plus `2u·Σ_j |m_ij|·max(|lo_j|, |hi_j|)` for the rounding of the matrix to
-//! `f32`. At `10^12` from an origin near the object that is a few ulps of the local size,
-//! where an `f32` world position would be off by `2^16`.
+//! Large worlds: poses with an `f64` translation, boxes relative to an `f64` origin (see
+//! [`LargePose`]).
 
 use glam::{Affine3A, DAffine3, DVec3, Quat, Vec3A};
 
@@ -38,12 +25,25 @@ impl LargeRigid3 {
 }
 
 /// A pose with an `f64` translation: [`LargeRigid3`] and glam's `DAffine3`.
+///
+/// Engines that keep positions in `f64` (Jolt's double build, Box2D's large-world build,
+/// Unreal) add the position to the local box in `f64` with round-to-nearest and only then
+/// round to `f32` outward, so the double rounding can leave the box. Here nothing is
+/// rounded to nearest on the way: the rotated box comes from the `f32` Outward kernel, and
+/// every `f64` step is exact (an error-free sum) before one directed rounding to `f32`.
+///
+/// **Bound.** Per face, the result exceeds the exact face by at most twice the Outward pad
+/// of the rotation (`(n + 2)·u·S + τ·TINY_PAD` with `S` the local magnitude, see
+/// [`crate::transform`]), plus one `f32` ulp of `t − origin` and two of the face; for
+/// `DAffine3`, plus `2u·Σ_j |m_ij|·max(|lo_j|, |hi_j|)` for the rounding of the matrix to
+/// `f32`. At `10^12` from an origin near the object that is a few ulps of the local size,
+/// where an `f32` world position would be off by `2^16`.
 pub trait LargePose: sealed::Sealed + Copy + Send + Sync {
     /// The box of `pose(x) − origin` over the points `x` of `local`, in `f32`, rounded
-    /// outward: it contains the exact image (see the [module docs](self) for the bound).
-    /// An empty box gives `EMPTY`; NaN or an infinity in the pose, the origin or the box
-    /// gives a box whose `is_valid()` is false, except that an unbounded local box gives
-    /// the exact unbounded result.
+    /// outward: it contains the exact image (see the [trait docs](LargePose) for the bound).
+    /// An empty box gives `EMPTY`; NaN anywhere, or an infinity in the pose or the origin,
+    /// gives a box whose `is_valid()` is false; an unbounded local box gives the unbounded
+    /// result.
     fn relative_aabb(&self, local: &Aabb3, origin: DVec3, method: Method) -> Aabb3;
 }
 
