@@ -247,6 +247,19 @@ fn rigid_scene(n: usize, r: &mut StdRng) -> Scene<Rigid3> {
     Scene { local, poses }
 }
 
+/// The active objects of a frame: all of them on every third frame, else about two
+/// thirds at random; as a list, as `u32` indices and as a mask.
+fn active_set(n: usize, frame: usize, r: &mut StdRng) -> (Vec<usize>, Vec<u32>, Vec<u64>) {
+    let subset: Vec<usize> = match frame % 3 {
+        0 => (0..n).collect(),
+        _ => (0..n).filter(|_| r.random_range(0..3) != 0).collect(),
+    };
+    let indices = subset.iter().map(|&i| i as u32).collect();
+    let mut mask = vec![0u64; n.div_ceil(64)];
+    subset.iter().for_each(|&i| mask[i / 64] |= 1 << (i % 64));
+    (subset, indices, mask)
+}
+
 fn step(poses: &mut [Rigid3], frame: usize, r: &mut StdRng) {
     for (k, p) in poses.iter_mut().enumerate() {
         let roll = r.random_range(0..100);
@@ -284,18 +297,10 @@ fn update_matches_the_brute_force_reference_on_every_backend_and_layout() {
                     for frame in 0..6 {
                         let before = fat.clone();
                         // Alternate the whole scene with active lists and masks.
-                        let subset: Vec<usize> = match frame % 3 {
-                            0 => (0..n).collect(),
-                            _ => (0..n).filter(|_| r.random_range(0..3) != 0).collect(),
-                        };
-                        let indices: Vec<u32> = subset.iter().map(|&i| i as u32).collect();
-                        let mut mask = vec![0u64; n.div_ceil(64)];
-                        subset.iter().for_each(|&i| mask[i / 64] |= 1 << (i % 64));
-                        let active = match frame % 3 {
-                            0 => Active::All,
-                            1 => Active::Indices(&indices),
-                            _ => Active::Mask(&mask),
-                        };
+                        // The whole scene, then an index list, then a mask.
+                        let (subset, indices, mask) = active_set(n, frame, &mut r);
+                        let active = [Active::All, Active::Indices(&indices), Active::Mask(&mask)]
+                            [frame % 3];
                         let (local, poses) = (&scene.local, &scene.poses);
                         update_on!(
                             layout, batch, margin, active, local, poses, &mut fat, &mut moved
@@ -368,13 +373,7 @@ fn aos_update_matches_single_box_calls_on_the_simd_backends() {
                 let (mut fat, mut want, mut moved) =
                     (vec![Aabb3::EMPTY; n], vec![Aabb3::EMPTY; n], Moved::new());
                 for frame in 0..6 {
-                    let subset: Vec<usize> = match frame % 3 {
-                        0 => (0..n).collect(),
-                        _ => (0..n).filter(|_| r.random_range(0..3) != 0).collect(),
-                    };
-                    let indices: Vec<u32> = subset.iter().map(|&i| i as u32).collect();
-                    let mut mask = vec![0u64; n.div_ceil(64)];
-                    subset.iter().for_each(|&i| mask[i / 64] |= 1 << (i % 64));
+                    let (subset, indices, mask) = active_set(n, frame, &mut r);
                     let active =
                         [Active::All, Active::Indices(&indices), Active::Mask(&mask)][frame % 3];
                     batch
