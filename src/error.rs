@@ -43,4 +43,4 @@ impl fmt::Display for TransformError {
     }
 }
 
-impl std::error::Error for TransformError {}
+impl core::error::Error for TransformError {}

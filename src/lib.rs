@@ -68,11 +68,16 @@
 //! [`tree::AabbTree`]) and tests two objects at any pair of poses with one simultaneous
 //! descent: the relative pose, `|R|` and one derived error pad are computed once per query,
 //! and no node pair that truly overlaps is culled. The leaf triangle test is exact.
+#![no_std]
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 // The public traits (`Transform3`, `BoxSource`, …) are sealed: their machinery (lane types,
 // kernels) is crate-private by design and reachable only through the sealed supertraits.
 #![allow(private_interfaces, private_bounds)]
+
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
 
 mod aabb;
 pub mod batch;
@@ -83,6 +88,7 @@ mod extended;
 mod fit;
 mod kernel;
 mod lane;
+mod math;
 pub mod method;
 mod projective;
 mod simd;

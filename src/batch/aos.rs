@@ -12,6 +12,7 @@ use crate::aabb::Boxes;
 use crate::lane::Vector;
 use crate::simd::LaneArray;
 use crate::transform::{Class, Fields, MAX_FIELDS};
+use alloc::vec::Vec;
 
 /// Items `i..i + count` of a slice, field `n` of item `k` in lane `k` of `f[n]`.
 #[inline(always)]

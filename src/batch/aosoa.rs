@@ -1,6 +1,7 @@
 //! AoSoA blocks: eight boxes or eight transforms per 32-byte-aligned block, one `[f32; 8]`
 //! per scalar field, so that a lane block is a handful of aligned vector loads.
 
+use alloc::vec::Vec;
 use glam::{Affine2, Affine3A};
 
 use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};

@@ -91,7 +91,7 @@ impl fmt::Display for BatchError {
     }
 }
 
-impl std::error::Error for BatchError {}
+impl core::error::Error for BatchError {}
 
 /// Boxes a batch reads, in some layout: see the [module docs](crate::batch) for the list.
 pub trait BoxSource<const N: usize>: sealed::ReadBoxes<N> {}
@@ -324,7 +324,9 @@ impl Batch {
     /// multiply-add is fused, and the AoS path runs in lanes like every other layout, so
     /// that every backend, every layout and the scalar reference give the same bits
     /// (on any x86-64 CPU, for the same build). It costs the fused backends a few percent
-    /// in cache; the default stays the fastest.
+    /// in cache; the default stays the fastest. Without the `std` feature the batch kernels
+    /// never fuse (`core` has no fused multiply-add), so the lane backends already give
+    /// these bits; only the AoS path still differs until this mode is chosen.
     #[must_use]
     pub fn deterministic(self) -> Self {
         Self {
@@ -455,6 +457,7 @@ mod tests {
     use super::*;
     use crate::simd::F32s;
     use crate::transform::{Rigid3, Trs3};
+    use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
 
     fn run_lanes<L: LaneArray, B: ReadBoxes<3>, X: ReadMaps<3>, O: WriteBoxes<3>>(

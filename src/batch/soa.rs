@@ -1,5 +1,7 @@
 //! SoA columns: one `f32` slice per scalar field, the layout of ECS-style storage.
 
+use alloc::vec;
+use alloc::vec::Vec;
 use glam::Affine3A;
 
 use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};

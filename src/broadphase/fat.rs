@@ -3,6 +3,7 @@
 
 use crate::batch::BatchError;
 use crate::lane::{Lane, Vector};
+use crate::math::pow2;
 use crate::{Aabb2, Aabb3};
 use glam::Vec3A;
 
@@ -66,7 +67,7 @@ impl Margin {
         let half = max * splat(0.5) - min * splat(0.5);
         let g = (half * splat(self.relative)).max(splat(self.absolute));
         let (x, y) = (min - g, max + g);
-        let step = |v: Vector<L, N>| (v.abs() * splat(2f32.powi(-22))).min(splat(f32::MAX));
+        let step = |v: Vector<L, N>| (v.abs() * splat(pow2(-22) as f32)).min(splat(f32::MAX));
         (x - step(x), y + step(y))
     }
 }

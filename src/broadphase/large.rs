@@ -1,6 +1,7 @@
 //! Large worlds: poses with an `f64` translation, boxes relative to an `f64` origin (see
 //! [`LargePose`]).
 
+use crate::math::pow2;
 use glam::{Affine3A, DAffine3, DVec3, Quat, Vec3A};
 
 use crate::Aabb3;
@@ -97,7 +98,7 @@ impl LargePose for DAffine3 {
                     }
                 })
                 .sum::<f64>()
-                * (1.0 + 2f64.powi(-50))
+                * (1.0 + pow2(-50))
         };
         let widen = DVec3::new(residual(0), residual(1), residual(2));
         offset(box_f, self.translation, origin, widen)
@@ -187,7 +188,7 @@ mod tests {
     #[test]
     fn directed_sums_bracket_the_exact_sum() {
         // 1 + 2^-30 is not an f32: the sum rounds to 1, up to the next f32 above.
-        let tiny = 2f32.powi(-30);
+        let tiny = crate::math::pow2(-30) as f32;
         assert_eq!(add_down(1.0, tiny), 1.0);
         assert_eq!(add_up(1.0, tiny), 1.0f32.next_up());
         assert_eq!(add_down(1.0, -tiny), 1.0f32.next_down());

@@ -1,5 +1,7 @@
 //! The moved set: which objects' fat boxes an update rewrote, as a bitset and as indices.
 
+use alloc::vec::Vec;
+
 /// The objects whose fat box the last [`Batch::update`](crate::Batch::update) rewrote:
 /// a bitset over all objects (bit `i % 64` of word `i / 64`) and the same set as
 /// ascending indices, the list a broadphase reinserts.

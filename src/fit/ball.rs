@@ -13,6 +13,10 @@
 //! the fits re-derive the radius of the rounded center from every point
 //! ([`super::bound`]). Recursion depth is at most `D + 1`.
 
+use crate::math::sqrt;
+use alloc::vec;
+use alloc::vec::Vec;
+
 /// A ball `|x − center|² <= radius2`; `radius2 < 0` is the empty ball.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Ball<const D: usize> {
@@ -40,7 +44,7 @@ impl<const D: usize> Ball<D> {
 
     /// The radius.
     pub fn radius(&self) -> f64 {
-        self.radius2.max(0.0).sqrt()
+        sqrt(self.radius2.max(0.0))
     }
 
     /// True when `p` is inside, up to the relative tolerance.

@@ -8,6 +8,8 @@ use super::obb::{Obb3, tight_frames};
 use super::search::compass_search;
 use super::{Fit, FitError};
 use crate::Aabb3;
+use crate::math::sqrt;
+use alloc::vec::Vec;
 use core::f64::consts::PI;
 use glam::{DVec3, Vec3, Vec3A};
 
@@ -121,9 +123,7 @@ fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Shape {
     for &p in points {
         let v = p - origin;
         let s = v.dot(dir);
-        let w = (radius * radius - (v - dir * s).length_squared())
-            .max(0.0)
-            .sqrt();
+        let w = sqrt((radius * radius - (v - dir * s).length_squared()).max(0.0));
         top = top.max(s - w);
         bottom = bottom.min(s + w);
     }
@@ -209,7 +209,7 @@ fn best_radius(points: &[DVec3], dir: DVec3) -> Shape {
         .map(|p| p.distance(middle))
         .fold(thinnest, f64::max);
     let volume = |r: f64| capped(points, origin, dir, r).volume();
-    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    let ratio = 0.5 * (sqrt(5.0) - 1.0);
     let (mut lo, mut hi) = (thinnest, widest);
     for _ in 0..RADIUS_STEPS {
         let (x1, x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));

@@ -2,6 +2,7 @@
 
 use super::FitError;
 use crate::Aabb3;
+use alloc::vec::Vec;
 use glam::{DMat3, DVec3, Vec3};
 
 /// Checks the input and returns its bounding box: an error for no point or a non-finite one.

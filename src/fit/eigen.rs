@@ -8,6 +8,7 @@
 //! eigenvalues) need no special case: the rotations stay orthogonal, so the eigenvectors of
 //! a repeated eigenvalue are some orthonormal basis of its eigenspace.
 
+use crate::math::hypot;
 use glam::DMat3;
 
 /// The cap on Jacobi sweeps (3 rotations each); convergence takes about 5.
@@ -72,8 +73,8 @@ fn jacobi_rotation(a: &DMat3, p: usize, q: usize) -> DMat3 {
         return j;
     }
     let theta = (a.col(q)[q] - a.col(p)[p]) / (2.0 * apq);
-    let t = theta.signum() / (theta.abs() + theta.hypot(1.0));
-    let c = 1.0 / t.hypot(1.0);
+    let t = theta.signum() / (theta.abs() + hypot(theta, 1.0));
+    let c = 1.0 / hypot(t, 1.0);
     let s = t * c;
     j.col_mut(p)[p] = c;
     j.col_mut(q)[q] = c;

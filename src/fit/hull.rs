@@ -11,9 +11,11 @@
 //! [`Hull::Point`]. The fits use the hull only to choose directions; containment never
 //! depends on it (every fit re-derives its extents from every input point).
 
+use alloc::collections::{BTreeMap, BTreeSet};
+use alloc::vec;
+use alloc::vec::Vec;
 use glam::DVec3;
 use robust::{Coord, Coord3D, orient2d, orient3d};
-use std::collections::{HashMap, HashSet};
 
 /// The convex hull, by the dimension of the points' affine hull.
 #[derive(Clone, Debug)]
@@ -92,7 +94,7 @@ struct Quickhull<'a> {
     alive: Vec<bool>,
     outside: Vec<Vec<usize>>,
     /// Directed edge `(u, v)` → the face that runs `u → v`.
-    edges: HashMap<(usize, usize), usize>,
+    edges: BTreeMap<(usize, usize), usize>,
 }
 
 impl<'a> Quickhull<'a> {
@@ -111,7 +113,7 @@ impl<'a> Quickhull<'a> {
             faces: Vec::new(),
             alive: Vec::new(),
             outside: Vec::new(),
-            edges: HashMap::new(),
+            edges: BTreeMap::new(),
         };
         let new_faces: Vec<usize> = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]]
             .into_iter()
@@ -198,8 +200,8 @@ impl<'a> Quickhull<'a> {
 
     /// The faces that see `eye`: a connected disk, found by a walk from `start`; in walk
     /// order (so the hull is the same on every run) and as a set.
-    fn visible_from(&self, start: usize, eye: usize) -> (Vec<usize>, HashSet<usize>) {
-        let (mut order, mut seen) = (vec![start], HashSet::from([start]));
+    fn visible_from(&self, start: usize, eye: usize) -> (Vec<usize>, BTreeSet<usize>) {
+        let (mut order, mut seen) = (vec![start], BTreeSet::from([start]));
         let mut next = 0;
         while let Some(&f) = order.get(next) {
             next += 1;
@@ -218,7 +220,7 @@ impl<'a> Quickhull<'a> {
     }
 
     fn into_hull(self) -> Hull {
-        let mut index = HashMap::new();
+        let mut index = BTreeMap::new();
         let mut vertices = Vec::new();
         let triangles = (0..self.faces.len())
             .filter(|&f| self.alive[f])

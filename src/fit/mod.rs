@@ -69,4 +69,4 @@ impl fmt::Display for FitError {
     }
 }
 
-impl std::error::Error for FitError {}
+impl core::error::Error for FitError {}

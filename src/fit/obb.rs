@@ -2,6 +2,8 @@
 
 use super::bound::Bounded;
 use super::cloud::{self, DIRECTIONS, exact};
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// DiTO-14's sample directions: the first 7 of [`DIRECTIONS`].
 const DITO_DIRECTIONS: [Vec3; 7] = [
@@ -19,8 +21,8 @@ use super::rect::min_area_rectangle;
 use super::search::compass_search;
 use super::{Fit, FitError};
 use crate::Aabb3;
+use alloc::collections::BTreeMap;
 use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
-use std::collections::BTreeMap;
 
 /// An oriented box: the points `x` with `|(x − center)·axis_k| <= half_extents[k]` for each
 /// column `axis_k` of `rotation`.

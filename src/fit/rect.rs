@@ -7,6 +7,7 @@
 //! in `f64` can only make the chosen direction slightly less than optimal: the fits measure
 //! their extents again from every point.
 
+use alloc::vec::Vec;
 use glam::DVec2;
 
 /// The convex hull, counter-clockwise, without collinear vertices (any order of input).

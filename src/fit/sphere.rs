@@ -5,6 +5,7 @@ use super::bound::{Bounded, segment_distance};
 use super::cloud::{self, DIRECTIONS, exact};
 use super::{Fit, FitError};
 use crate::Aabb3;
+use alloc::vec::Vec;
 use glam::{DVec3, Vec3, Vec3A};
 
 /// A ball: the points `x` with `|x − center| <= radius`, exactly, on the `f32` fields.
@@ -62,7 +63,11 @@ impl Sphere {
     #[inline]
     #[must_use]
     pub fn volume(&self) -> f32 {
-        (4.0 / 3.0 * core::f64::consts::PI * f64::from(self.radius).powi(3)) as f32
+        (4.0 / 3.0
+            * core::f64::consts::PI
+            * f64::from(self.radius)
+            * f64::from(self.radius)
+            * f64::from(self.radius)) as f32
     }
 
     /// An axis-aligned box, rounded outward, that contains the ball: `c ± r`, one rounding

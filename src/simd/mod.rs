@@ -4,11 +4,13 @@
 //! lane type for the chosen [`Backend`] and, for AVX2+FMA and AVX-512, instantiates the job
 //! inside a `#[target_feature]` wrapper so that the plain array code is compiled for those
 //! instructions, although the crate itself is built for the baseline target. The best
-//! backend of the running CPU is detected once and cached.
+//! backend of the running CPU is detected once and cached. Without the `std` feature there
+//! is no run-time detection: a backend is supported when the build's target features
+//! guarantee it (`-C target-cpu=…` or `-C target-feature=+avx2,+fma`).
 
 mod lanes;
 
-use std::sync::OnceLock;
+use alloc::vec::Vec;
 
 pub(crate) use lanes::{F32s, LaneArray};
 
@@ -39,21 +41,27 @@ impl Backend {
         Backend::Avx512,
     ];
 
-    /// True when the running CPU can execute this backend.
+    /// True when the running CPU can execute this backend: detected at run time with the
+    /// `std` feature, and without it true only when the build's target features guarantee
+    /// the instructions.
     #[must_use]
     pub fn is_supported(self) -> bool {
         match self {
             Backend::Scalar | Backend::Baseline | Backend::Wide => true,
-            #[cfg(target_arch = "x86_64")]
+            #[cfg(all(target_arch = "x86_64", feature = "std"))]
             Backend::Avx2 => {
                 std::arch::is_x86_feature_detected!("avx2")
                     && std::arch::is_x86_feature_detected!("fma")
             }
-            #[cfg(target_arch = "x86_64")]
+            #[cfg(all(target_arch = "x86_64", feature = "std"))]
             Backend::Avx512 => {
                 std::arch::is_x86_feature_detected!("avx512f")
                     && std::arch::is_x86_feature_detected!("fma")
             }
+            #[cfg(all(target_arch = "x86_64", not(feature = "std")))]
+            Backend::Avx2 => cfg!(all(target_feature = "avx2", target_feature = "fma")),
+            #[cfg(all(target_arch = "x86_64", not(feature = "std")))]
+            Backend::Avx512 => cfg!(all(target_feature = "avx512f", target_feature = "fma")),
             #[cfg(not(target_arch = "x86_64"))]
             Backend::Avx2 | Backend::Avx512 => false,
         }
@@ -68,7 +76,8 @@ impl Backend {
             .collect()
     }
 
-    /// The fastest supported backend, detected on first use and cached.
+    /// The fastest supported backend, detected on first use and cached (without `std`:
+    /// the fastest the build's target features guarantee).
     ///
     /// AVX2+FMA comes first: on the AVX-512 machine it was measured on (an AMD EPYC VM),
     /// the 16-lane instantiation ran 1.4–2× slower than the 8-lane one (AoSoA, 1K boxes:
@@ -76,13 +85,19 @@ impl Backend {
     /// with [`crate::Batch::on`] until its lanes are tuned.
     #[must_use]
     pub fn detect() -> Backend {
-        static DETECTED: OnceLock<Backend> = OnceLock::new();
-        *DETECTED.get_or_init(|| {
+        let fastest = || {
             [Backend::Avx2, Backend::Avx512, Backend::Baseline]
                 .into_iter()
                 .find(|b| b.is_supported())
                 .unwrap_or(Backend::Scalar)
-        })
+        };
+        #[cfg(feature = "std")]
+        {
+            static DETECTED: std::sync::OnceLock<Backend> = std::sync::OnceLock::new();
+            *DETECTED.get_or_init(fastest)
+        }
+        #[cfg(not(feature = "std"))]
+        fastest()
     }
 
     /// Boxes per lane block.
@@ -116,12 +131,15 @@ pub(crate) trait Job {
 }
 
 /// Runs `job` on `backend`, which the caller has checked is supported; `fused` lets the
-/// AVX2 and AVX-512 lanes fuse multiply-adds. Unfused, every backend does the same
+/// AVX2 and AVX-512 lanes fuse multiply-adds (with the `std` feature only). Unfused, every backend does the same
 /// arithmetic as the scalar reference (`wide` then runs the baseline lanes, since its
 /// fusing is fixed at compile time).
 #[allow(unsafe_code)] // the one place: calling the `#[target_feature]` wrappers
 pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     debug_assert!(backend.is_supported());
+    // Without `std` the fused lanes would call libm's software `fmaf`: `core` has no fused
+    // multiply-add to compile to. Every backend then runs unfused, as in deterministic mode.
+    let fused = fused && cfg!(feature = "std");
     match (backend, fused) {
         (Backend::Scalar, _) => job.run::<f32>(),
         (Backend::Baseline, _) | (Backend::Wide, false) => job.run::<F32s<8, false>>(),

@@ -45,7 +45,7 @@ impl Rigid2 {
     #[inline]
     #[must_use]
     pub fn from_angle_translation(angle: f32, translation: Vec2) -> Self {
-        let (sin, cos) = angle.sin_cos();
+        let (sin, cos) = crate::math::sin_cos(angle);
         Self::new(cos, sin, translation)
     }
 

@@ -6,6 +6,8 @@
 //! primitive is the next node.
 
 use super::nodes::{Ref, Store};
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// Bins per axis.
 const BINS: usize = 16;

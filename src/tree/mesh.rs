@@ -1,6 +1,7 @@
 //! The objects a tree is built over: [`TriMesh`] (triangles, boxes derived from vertices)
 //! and [`AabbTree`] (bare primitive boxes), each with its [`Hierarchy`].
 
+use alloc::vec::Vec;
 use core::fmt;
 
 use glam::{DVec3, Vec3, Vec3A};
@@ -78,7 +79,7 @@ impl fmt::Display for MeshError {
     }
 }
 
-impl std::error::Error for MeshError {}
+impl core::error::Error for MeshError {}
 
 /// A tree over primitives: the nodes in a [`Layout`], the root and the reach.
 #[derive(Clone, Debug)]

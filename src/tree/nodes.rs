@@ -13,6 +13,8 @@
 //! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
 //! coordinate (`origin + step·c`); the query pad covers that rounding.
 
+use crate::math::{ceil, pow2, pow2_at_least, round};
+use alloc::vec::Vec;
 use glam::Vec3A;
 
 /// A child: a node index, or a primitive id with the top bit set.
@@ -164,11 +166,10 @@ impl Quantized {
             let o = lo[k] * 0.5 + hi[k] * 0.5;
             let extent = (f64::from(hi[k]) - f64::from(o)).max(f64::from(o) - f64::from(lo[k]));
             let need = (extent / GRID)
-                .max(f64::from(o).abs() * 2f64.powi(-20))
-                .max(2f64.powi(-126));
+                .max(f64::from(o).abs() * pow2(-20))
+                .max(pow2(-126));
             // A power of two (exact in f32: at most 2^128 · 2^-15 for finite input).
-            let s = 2f64.powi(need.log2().ceil() as i32);
-            let s = if s < need { s * 2.0 } else { s };
+            let s = pow2_at_least(need);
             origin[k] = o;
             step[k] = s as f32;
         }
@@ -187,9 +188,9 @@ impl Quantized {
             let (o, s) = (f64::from(origin[k]), f64::from(step[k]));
             let (l, h) = (f64::from(lo[k]), f64::from(hi[k]));
             let mid = (l * 0.5 + h * 0.5 - o) / s;
-            let ck = mid.round().clamp(-GRID, GRID);
+            let ck = round(mid).clamp(-GRID, GRID);
             let center = o + ck * s;
-            let reach = ((h - center).max(center - l) / s).max(0.0).ceil() + 1.0;
+            let reach = ceil(((h - center).max(center - l) / s).max(0.0)) + 1.0;
             c[k] = ck as i16;
             e[k] = reach.min(f64::from(u16::MAX)) as u16;
         }

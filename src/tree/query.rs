@@ -1,6 +1,7 @@
 //! Queries between two trees at two poses: one simultaneous descent of both trees, with the
 //! relative pose, `|R|` and the pad of [`Relative`] computed once.
 
+use alloc::vec::Vec;
 use core::ops::ControlFlow;
 
 use glam::{DVec3, Vec3A};

@@ -66,6 +66,7 @@
 //! by the radii plus `‖L‖₁·(δ_a + m·δ_b + |w|) <= ‖L‖₁·P`, and the `f64` evaluation errs by
 //! far less than the second term.
 
+use crate::math::{pow2, sqrt};
 use glam::{DMat3, DVec3, Quat, Vec3A};
 
 use crate::transform::{Rigid3, Similarity3};
@@ -266,7 +267,7 @@ impl Relative {
     /// The `f64` margin of the root cross-axis test: `2^-46·(1 + m)(R_a + R_b + T)`.
     pub(crate) fn cross_margin(&self, reach_a: f32, reach_b: f32) -> f64 {
         let (m, t) = norms(&self.m, &self.n, self.t, self.t_b.as_dvec3());
-        2f64.powi(-46) * (1.0 + m) * (f64::from(reach_a) + f64::from(reach_b) + t)
+        pow2(-46) * (1.0 + m) * (f64::from(reach_a) + f64::from(reach_b) + t)
     }
 }
 
@@ -278,8 +279,8 @@ fn norms(m: &DMat3, n: &DMat3, t: DVec3, t_b: DVec3) -> (f64, f64) {
         let rows = (0..3).map(|i| abs.row(i).element_sum());
         rows.chain(cols).fold(0.0, f64::max)
     };
-    let m = sums(m).max(sums(n)) * (1.0 + 2f64.powi(-40));
-    let t = t.abs().max_element().max(t_b.abs().max_element()) * (1.0 + 2f64.powi(-40));
+    let m = sums(m).max(sums(n)) * (1.0 + pow2(-40));
+    let t = t.abs().max_element().max(t_b.abs().max_element()) * (1.0 + pow2(-40));
     (m, t)
 }
 
@@ -294,36 +295,36 @@ fn pad(
     tolerance: f32,
 ) -> f32 {
     let (mm, tt) = norms(m, n, t, t_b);
-    let grow = 1.0 + 2f64.powi(-18);
+    let grow = 1.0 + pow2(-18);
     let (ra, rb) = (f64::from(reach_a) * grow, f64::from(reach_b) * grow);
-    let tiny = 2f64.powi(-148);
+    let tiny = pow2(-148);
     let (delta_a, delta_b) = (2.0 * U * ra + tiny, 2.0 * U * rb + tiny);
     let max_entry = [m.x_axis, m.y_axis, m.z_axis, n.x_axis, n.y_axis, n.z_axis]
         .iter()
         .map(|c| c.abs().max_element())
         .fold(0.0, f64::max);
-    let eps_m = U * max_entry + 2f64.powi(-150);
-    let eps_64 = 2f64.powi(-50) * (mm * rb + tt);
+    let eps_m = U * max_entry + pow2(-150);
+    let eps_64 = pow2(-50) * (mm * rb + tt);
     // ‖NM − I‖_F computed in f64, plus its own rounding (γ₆₄(3)·m² per entry, 9 entries).
     let e = *n * *m - DMat3::IDENTITY;
-    let frob = [e.x_axis, e.y_axis, e.z_axis]
-        .iter()
-        .map(|c| c.length_squared())
-        .sum::<f64>()
-        .sqrt()
-        + 9.0 * 2f64.powi(-50) * mm * mm;
+    let frob = sqrt(
+        [e.x_axis, e.y_axis, e.z_axis]
+            .iter()
+            .map(|c| c.length_squared())
+            .sum::<f64>(),
+    ) + 9.0 * pow2(-50) * mm * mm;
     // Past 2^126 the f32 sums of a node-pair test could overflow (an infinite distance
     // against a finite radius would separate): no pair is culled there.
-    if (1.0 + mm) * (ra + rb + tt) >= 2f64.powi(126) {
+    if (1.0 + mm) * (ra + rb + tt) >= pow2(126) {
         return f32::INFINITY;
     }
     let sum = (1.0 + mm) * (delta_a + delta_b + eps_64 + f64::from(tolerance))
         + 3.0 * eps_m * (ra + rb)
-        + 2.0 * (U + 2f64.powi(-50) * mm) * tt
+        + 2.0 * (U + pow2(-50) * mm) * tt
         + tiny
-        + frob * 3f64.sqrt() * rb
+        + frob * sqrt(3.0) * rb
         + 12.0 * U * (1.0 + mm) * (ra + rb + tt);
-    let p = sum * (1.0 + 2f64.powi(-20));
+    let p = sum * (1.0 + pow2(-20));
     let p32 = p as f32;
     if f64::from(p32) < p {
         p32.next_up()

@@ -1,0 +1,51 @@
+//! The float functions `core` lacks: the standard library's where it is linked (feature
+//! `std`), `libm`'s otherwise. Both are correctly rounded where the callers need it
+//! (`sqrt`, `mul_add`, `ceil`, `round`); `hypot` and `sin_cos` feed no bound.
+
+/// `2^k` for `-1022 <= k <= 1023`, exactly.
+pub(crate) const fn pow2(k: i32) -> f64 {
+    assert!(-1022 <= k && k <= 1023);
+    f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// The smallest power of two not below `x`, for a positive normal `x`, exactly.
+pub(crate) fn pow2_at_least(x: f64) -> f64 {
+    let below = f64::from_bits(x.to_bits() & (0x7ff << 52));
+    if below < x { below * 2.0 } else { below }
+}
+
+macro_rules! forward {
+    ($($(#[$doc:meta])* fn $name:ident($($arg:ident: $t:ty),*) -> $r:ty = $libm:ident;)*) => {$(
+        $(#[$doc])*
+        #[inline(always)]
+        pub(crate) fn $name($($arg: $t),*) -> $r {
+            #[cfg(feature = "std")]
+            return forward!(@std $name $($arg),*);
+            #[cfg(not(feature = "std"))]
+            return libm::$libm($($arg),*);
+        }
+    )*};
+    (@std $name:ident $first:ident $(, $rest:ident)*) => { $first.$name($($rest),*) };
+}
+
+forward! {
+    /// The correctly rounded square root.
+    fn sqrt(x: f64) -> f64 = sqrt;
+    /// The smallest integer not below `x`.
+    fn ceil(x: f64) -> f64 = ceil;
+    /// `x` rounded to the nearest integer, ties away from zero.
+    fn round(x: f64) -> f64 = round;
+    /// `sqrt(x² + y²)` without undue overflow.
+    fn hypot(x: f64, y: f64) -> f64 = hypot;
+    /// `a·b + c` with one rounding.
+    fn mul_add(a: f32, b: f32, c: f32) -> f32 = fmaf;
+}
+
+/// The sine and cosine of `x` radians.
+#[inline]
+pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+    #[cfg(feature = "std")]
+    return x.sin_cos();
+    #[cfg(not(feature = "std"))]
+    return libm::sincosf(x);
+}
