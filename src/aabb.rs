@@ -11,7 +11,10 @@ use glam::{Vec2, Vec3A};
 use crate::transform::{Fields, MAX_FIELDS};
 
 /// An axis-aligned box in 3D, `min <= p <= max`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Aabb3 {
     /// The lower corner.
     pub min: Vec3A,
@@ -20,7 +23,10 @@ pub struct Aabb3 {
 }
 
 /// An axis-aligned box in 2D, `min <= p <= max`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Aabb2 {
     /// The lower corner.
     pub min: Vec2,

@@ -41,6 +41,7 @@ pub fn gamma(n: u32) -> f64 {
 }
 
 /// How a box is carried through the transform.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Method {
     /// Transform every corner (8 in 3D, 4 in 2D) and take the component-wise min and max.
@@ -94,6 +95,7 @@ impl Method {
 }
 
 /// Which guarantee the result carries.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Rounding {
     /// Plain round-to-nearest arithmetic: faces within the method's documented error bound

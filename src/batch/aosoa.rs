@@ -43,6 +43,30 @@ pub type Trs3x8 = Block8<Trs3>;
 /// Eight rigid 2D poses: `cos, sin`, then the translation.
 pub type Rigid2x8 = Block8<Rigid2>;
 
+// Pod per class: the derive cannot see through the sealed `Fields::Array`, so each block
+// states its field array, and the compiler checks it and the size.
+#[cfg(feature = "bytemuck")]
+macro_rules! pod_blocks {
+    ($($t:ty: $fields:literal),* $(,)?) => {$(
+        const _: fn(Block8<$t>) -> [[f32; 8]; $fields] = |block| block.fields;
+        const _: () = assert!(size_of::<Block8<$t>>() == 32 * $fields);
+        // SAFETY: `Block8<$t>` is `repr(C, align(32))` around exactly `[[f32; 8]; $fields]`
+        // (both checked above): no padding (its size is a multiple of its alignment), every
+        // bit pattern a valid `f32`, no pointer or interior mutability; `Copy + 'static`.
+        #[allow(unsafe_code)]
+        unsafe impl bytemuck::Zeroable for Block8<$t> {}
+        // SAFETY: as above.
+        #[allow(unsafe_code)]
+        unsafe impl bytemuck::Pod for Block8<$t> {}
+    )*};
+}
+
+#[cfg(feature = "bytemuck")]
+pod_blocks! {
+    Aabb3: 6, Aabb2: 4, Affine3A: 12, Affine2: 6, Translation3: 3, Translation2: 2,
+    Rigid3: 7, Similarity3: 8, Trs3: 10, Rigid2: 4,
+}
+
 impl<T: Fields> Clone for Block8<T>
 where
     T::Array<[f32; 8]>: Clone,

@@ -163,7 +163,7 @@ pub(crate) mod sealed {
         /// Disjoint parts of `chunk` boxes each, in order (the last may be shorter);
         /// `chunk` is a multiple of 16, so that parts start on whole AoSoA and lane blocks.
         #[cfg(feature = "rayon")]
-        fn parts(&mut self, chunk: usize) -> Vec<Self::Part<'_>>;
+        fn parts(&mut self, chunk: usize) -> alloc::vec::Vec<Self::Part<'_>>;
     }
 
     /// Transforms to read.

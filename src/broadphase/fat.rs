@@ -12,7 +12,10 @@ use glam::Vec3A;
 ///
 /// A larger margin rewrites fewer fat boxes per frame and makes the broadphase report more
 /// pairs; Box2D uses an absolute margin of 0.1 m, Jolt and rapier a fraction of the size.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Margin {
     /// The least growth of every face, in world units.
     pub absolute: f32,

@@ -9,7 +9,10 @@ use crate::method::{Method, Rounding};
 use crate::transform::Rigid3;
 
 /// A rigid pose for large worlds: an `f32` rotation and an `f64` position, `x ↦ R(q)·x + p`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct LargeRigid3 {
     /// The rotation; the exact map uses `R(q)` as [`Rigid3`] does, with no normalisation.
     pub rotation: Quat,

@@ -15,7 +15,10 @@ use glam::{DVec3, Vec3, Vec3A};
 
 /// A capsule: the points `x` within `radius` of the segment `[a, b]`, exactly, on the `f32`
 /// fields (`dist(x, [a, b]) = min over real t ∈ [0, 1] of |x − a − t(b − a)|`).
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Capsule {
     /// One end of the axis segment.
     pub a: Vec3A,

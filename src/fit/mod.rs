@@ -33,6 +33,7 @@ pub use world::BoundingVolume;
 use core::fmt;
 
 /// How hard a fit works: the PCA baseline, a fast fit (the default) or a tight one.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Fit {
     /// The classic baseline: principal axes of the distinct points, centered on their mean.

@@ -29,7 +29,10 @@ use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
 ///
 /// The statement is exact on the `f32` fields as given: fitted rotations are orthonormal to
 /// within `f32` rounding, and the box is the parallelepiped those three slabs cut out.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Obb3 {
     /// The center.
     pub center: Vec3A,

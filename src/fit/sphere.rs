@@ -9,7 +9,10 @@ use alloc::vec::Vec;
 use glam::{DVec3, Vec3, Vec3A};
 
 /// A ball: the points `x` with `|x − center| <= radius`, exactly, on the `f32` fields.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Sphere {
     /// The center.
     pub center: Vec3A,

@@ -15,6 +15,7 @@ use alloc::vec::Vec;
 pub(crate) use lanes::{F32s, LaneArray};
 
 /// A code path for the batch kernels.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Backend {
     /// One box at a time in plain `f32`: the reference every other backend is tested against.

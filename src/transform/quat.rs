@@ -16,7 +16,10 @@ use crate::method::Method;
 use crate::simd::Backend;
 
 /// A rotation then a translation: `x ↦ R(q)·x + t`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Rigid3 {
     /// The rotation; used as stored (see the [module docs](crate::transform)).
     pub rotation: Quat,
@@ -25,7 +28,10 @@ pub struct Rigid3 {
 }
 
 /// A uniform scale, a rotation, then a translation: `x ↦ R(q)·(σ·x) + t`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Similarity3 {
     /// The uniform scale `σ` (negative is a point reflection).
     pub scale: f32,
@@ -37,7 +43,10 @@ pub struct Similarity3 {
 
 /// A per-axis scale, a rotation, then a translation: `x ↦ R(q)·(s ∘ x) + t`, the order of
 /// bevy's `Transform`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Trs3 {
     /// The per-axis scale `s`, applied first (negative and zero entries are allowed).
     pub scale: Vec3A,

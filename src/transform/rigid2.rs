@@ -12,7 +12,10 @@ use crate::method::Method;
 ///
 /// `cos` and `sin` are used as given; a pair that has drifted off the unit circle is a
 /// slightly scaled rotation, and every kernel still bounds the exact image of that map.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Rigid2 {
     /// The cosine of the rotation angle.
     pub cos: f32,

@@ -11,11 +11,17 @@ use crate::method::Method;
 use crate::simd::Backend;
 
 /// A 3D translation `x ↦ x + t`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(transparent)]
 pub struct Translation3(pub Vec3A);
 
 /// A 2D translation `x ↦ x + t`.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(transparent)]
 pub struct Translation2(pub Vec2);
 
 impl Translation3 {
