@@ -142,12 +142,39 @@ impl TransformClass {
     }
 }
 
-/// What a row measured: a bvkit kernel, a peer (named), or a memory roofline.
+/// What a row measured: a bvkit kernel, a peer, or a memory roofline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     Kernel(Method, Rounding),
-    Peer(&'static str),
+    Peer(Peer),
     Roofline,
+}
+
+/// The loops a user would otherwise write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Peer {
+    /// parry3d's `Aabb::transform_by` over rigid poses. In the 3D affine class it runs on
+    /// the rigid poses of that class's scene: a speed reference, no affine peer.
+    Parry,
+    /// glam: transform the 8 corners.
+    GlamCorners,
+    /// glam: center and half-extents through `|M|`.
+    GlamAbsMatrix,
+    /// glam on rigid poses: `Mat3A::from_quat`, then abs-matrix.
+    GlamRigid,
+}
+
+impl Peer {
+    /// The peer's name in `class`, as the CSV has it.
+    pub const fn name(self, class: TransformClass) -> &'static str {
+        match (self, class) {
+            (Peer::Parry, TransformClass::Rigid3) => "parry3d Aabb::transform_by",
+            (Peer::Parry, _) => "parry3d Aabb::transform_by (rigid)",
+            (Peer::GlamCorners, _) => "glam 8-corner loop",
+            (Peer::GlamAbsMatrix, _) => "glam abs-matrix loop",
+            (Peer::GlamRigid, _) => "glam loop: Mat3A::from_quat + abs-matrix",
+        }
+    }
 }
 
 /// How the boxes and poses are laid out.
@@ -220,7 +247,7 @@ impl Row {
     pub fn name(&self) -> String {
         match self.kind {
             Kind::Kernel(m, r) => format!("{} {}", m.name(), r.name()),
-            Kind::Peer(name) => name.into(),
+            Kind::Peer(peer) => peer.name(self.class).into(),
             Kind::Roofline => "memory roofline".into(),
         }
     }
@@ -310,16 +337,15 @@ impl<'a> Meter<'a> {
         accuracy: Option<Accuracy>,
     ) {
         // The 2D classes share their stages: their items name the class.
-        let class = if self.class.is_2d() {
-            self.class.name()
-        } else {
-            ""
-        };
-        self.progress.item(&match kind {
-            Kind::Kernel(..) => format!("{class} {} {backend}", layout.name()),
-            Kind::Peer(name) => name.into(),
+        let item = match kind {
+            Kind::Kernel(..) if self.class.is_2d() => {
+                format!("{} {} {backend}", self.class.name(), layout.name())
+            }
+            Kind::Kernel(..) => format!("{} {backend}", layout.name()),
+            Kind::Peer(peer) => peer.name(self.class).into(),
             Kind::Roofline => format!("roofline {}", layout.name()),
-        }.trim_start());
+        };
+        self.progress.item(&item);
         self.rows.push(Row {
             class: self.class,
             kind,
@@ -343,8 +369,8 @@ impl<'a> Meter<'a> {
         self.push(kind, layout, backend, times, Some(accuracy));
     }
 
-    fn peer(&mut self, name: &'static str, times: (f64, f64), accuracy: Option<Accuracy>) {
-        self.push(Kind::Peer(name), Layout::Aos, "peer", times, accuracy);
+    fn peer(&mut self, peer: Peer, times: (f64, f64), accuracy: Option<Accuracy>) {
+        self.push(Kind::Peer(peer), Layout::Aos, "peer", times, accuracy);
     }
 
     fn roofline(&mut self, layout: Layout, times: (f64, f64)) {
@@ -463,7 +489,7 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     let t = times(|n| {
         common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
     });
-    m.peer("parry3d Aabb::transform_by (rigid)", t, None);
+    m.peer(Peer::Parry, t, None);
     let peer_accuracy = |f: fn(&[Aabb3], &[Affine3A], &mut [Aabb3])| {
         let mut o = vec![Aabb3::EMPTY; sb.len()];
         f(&sb, &sx, &mut o);
@@ -473,16 +499,12 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     let t = times(|n| {
         common::glam_corners(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
     });
-    m.peer(
-        "glam 8-corner loop",
-        t,
-        peer_accuracy(common::glam_corners),
-    );
+    m.peer(Peer::GlamCorners, t, peer_accuracy(common::glam_corners));
     let t = times(|n| {
         common::glam_abs_matrix(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
     });
     m.peer(
-        "glam abs-matrix loop",
+        Peer::GlamAbsMatrix,
         t,
         peer_accuracy(common::glam_abs_matrix),
     );
@@ -571,13 +593,7 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
             let mut so = vec![Aabb3::EMPTY; sb.len()];
             batch.transform(&sb, &sx, &mut so).unwrap();
             let results: Vec<_> = so.iter().map(flat3).collect();
-            m.kernel(
-                k,
-                Layout::Aos,
-                name,
-                t,
-                accuracy(&sample, &results, bound),
-            );
+            m.kernel(k, Layout::Aos, name, t, accuracy(&sample, &results, bound));
 
             let t = (
                 ns_per_box(CACHE, CACHE_RUNS, || {
@@ -596,13 +612,7 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
                 .transform(ssb.view(), ssx.view(), sso.view_mut())
                 .unwrap();
             let results: Vec<_> = (0..sb.len()).map(|k| flat3(&sso.get(k))).collect();
-            m.kernel(
-                k,
-                Layout::Soa,
-                name,
-                t,
-                accuracy(&sample, &results, bound),
-            );
+            m.kernel(k, Layout::Soa, name, t, accuracy(&sample, &results, bound));
 
             let t = times(|n| {
                 batch
@@ -738,7 +748,7 @@ pub fn classes3(best: Backend, progress: &Progress) -> Vec<Row> {
     let t = times(|n| {
         common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
     });
-    m.peer("parry3d Aabb::transform_by", t, None);
+    m.peer(Peer::Parry, t, None);
     let t = times(|n| {
         common::glam_rigid_abs_matrix(
             black_box(&s.boxes[..n]),
@@ -752,7 +762,7 @@ pub fn classes3(best: Backend, progress: &Progress) -> Vec<Row> {
     common::glam_rigid_abs_matrix(&sb, &sx, &mut so);
     let results: Vec<_> = so.iter().map(flat3).collect();
     m.peer(
-        "glam loop: Mat3A::from_quat + abs-matrix",
+        Peer::GlamRigid,
         t,
         Some(accuracy(&rigid, &results, PEER_BOUND)),
     );
@@ -923,4 +933,3 @@ pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
 pub fn cases_per_kernel() -> u64 {
     CASES * ACCURACY_CLASSES.len() as u64
 }
-

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use bvkit::{Method, Rounding};
 
-use crate::measure::{CACHE, Kind, Row, SCALAR, TransformClass};
+use crate::measure::{CACHE, Kind, Peer, Row, SCALAR, TransformClass};
 
 /// Panels per row.
 const COLUMNS: usize = 2;
@@ -179,15 +179,18 @@ fn label(row: &Row) -> Option<String> {
             let backend = if row.backend == SCALAR { " scalar" } else { "" };
             Some(format!("{m}/{r} {}{backend}", row.layout.name()))
         }
-        Kind::Peer(name) => match name {
-            "glam 8-corner loop" => Some("glam 8-corner loop".into()),
-            "glam abs-matrix loop" => Some("glam abs-matrix loop".into()),
-            "glam loop: Mat3A::from_quat + abs-matrix" => Some("glam from_quat loop".into()),
-            "parry3d Aabb::transform_by" => Some("parry3d loop (error n/a)".into()),
-            // parry3d timed on the affine scene's rigid poses: no affine peer; it is
-            // plotted in the rigid panel.
-            _ => None,
-        },
+        // parry3d in another class than rigid ran on that scene's rigid poses: no peer
+        // of the class.
+        Kind::Peer(Peer::Parry) if row.class != TransformClass::Rigid3 => None,
+        Kind::Peer(peer) => Some(
+            match peer {
+                Peer::Parry => "parry3d loop (error n/a)",
+                Peer::GlamCorners => "glam 8-corner loop",
+                Peer::GlamAbsMatrix => "glam abs-matrix loop",
+                Peer::GlamRigid => "glam from_quat loop",
+            }
+            .into(),
+        ),
         Kind::Roofline => None,
     }
 }
@@ -313,7 +316,10 @@ fn place(
         (0.0, 1.0),
     ];
     let mut best: Option<(usize, Rect, bool)> = None;
-    for (step, extra) in [3.0, 9.0, 16.0, 26.0, 40.0, 58.0, 80.0].into_iter().enumerate() {
+    for (step, extra) in [3.0, 9.0, 16.0, 26.0, 40.0, 58.0, 80.0]
+        .into_iter()
+        .enumerate()
+    {
         for d in DIRECTIONS {
             let r = candidate(x, y, size, half + extra, d);
             if !area.contains(&r) {
@@ -332,21 +338,45 @@ fn place(
     (r, leader)
 }
 
-/// The SVG of one marker.
+/// A circle of radius `r`; `extra` holds further attributes.
+fn circle(x: f64, y: f64, r: f64, fill: &str, extra: &str) -> String {
+    format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="{fill}"{extra}/>"#)
+}
+
+/// A square of half-side `half`; `extra` holds further attributes.
+fn square(x: f64, y: f64, half: f64, fill: &str, extra: &str) -> String {
+    format!(
+        r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{fill}"{extra}/>"#,
+        x - half,
+        y - half,
+        2.0 * half,
+        2.0 * half
+    )
+}
+
+/// A peer's black diamond.
+fn diamond(x: f64, y: f64) -> String {
+    let h = PEER;
+    format!(
+        r#"<polygon points="{x:.1},{:.1} {:.1},{y:.1} {x:.1},{:.1} {:.1},{y:.1}" fill="black"/>"#,
+        y - h,
+        x + h,
+        y + h,
+        x - h
+    )
+}
+
+/// A dashed vertical line: the speed of a peer without a measured error.
+fn dashed(x: f64, y0: f64, y1: f64) -> String {
+    format!(
+        r##"<line x1="{x:.1}" y1="{y0:.1}" x2="{x:.1}" y2="{y1:.1}" stroke="#333" stroke-dasharray="5 4"/>"##
+    )
+}
+
+/// The SVG of one point's marker.
 fn marker(p: &Point, x: f64, y: f64, on_front: bool) -> String {
     if p.peer() {
-        let s = PEER;
-        return format!(
-            r#"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1} {:.1},{:.1}" fill="black"/>"#,
-            x,
-            y - s,
-            x + s,
-            y,
-            x,
-            y + s,
-            x - s,
-            y
-        );
+        return diamond(x, y);
     }
     let (color, half) = match (p.outward(), on_front) {
         (false, false) => (NEAREST_PALE, SMALL),
@@ -360,15 +390,9 @@ fn marker(p: &Point, x: f64, y: f64, on_front: bool) -> String {
         ""
     };
     if p.outward() {
-        format!(
-            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{color}"{stroke}/>"#,
-            x - half,
-            y - half,
-            2.0 * half,
-            2.0 * half
-        )
+        square(x, y, half, color, stroke)
     } else {
-        format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="{half:.1}" fill="{color}"{stroke}/>"#)
+        circle(x, y, half, color, stroke)
     }
 }
 
@@ -467,14 +491,19 @@ fn panel(s: &mut String, class: TransformClass, points: &[Point], axes: &Axes) -
     let mut obstacles = Obstacles::default();
     for (i, p) in points.iter().enumerate() {
         match xy(p) {
-            (x, Some(y)) => obstacles
-                .rects
-                .push(Rect::around(x, y, half_size(p, on_front(i)) + 1.0)),
+            (x, Some(y)) => {
+                obstacles
+                    .rects
+                    .push(Rect::around(x, y, half_size(p, on_front(i)) + 1.0))
+            }
             (x, None) => obstacles.segments.push(((x, a.y0), (x, a.y1))),
         }
     }
     let mut lines = String::new();
     for (front, color) in [(&outward, OUTWARD), (&all, NEAREST)] {
+        if front.len() < 2 {
+            continue;
+        }
         let vertices: Vec<(f64, f64)> = front
             .iter()
             .map(|&i| (axes.px(points[i].ns), axes.py(points[i].error.unwrap())))
@@ -496,13 +525,7 @@ fn panel(s: &mut String, class: TransformClass, points: &[Point], axes: &Axes) -
 
     // Peers without an error: a dashed vertical line at their speed.
     for p in points.iter().filter(|p| p.error.is_none()) {
-        let x = axes.px(p.ns);
-        write!(
-            s,
-            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#333" stroke-dasharray="5 4"/>"##,
-            a.y0, a.y1
-        )
-        .unwrap();
+        s.push_str(&dashed(axes.px(p.ns), a.y0, a.y1));
     }
     s.push_str(&lines);
     // Off-front markers under front markers under peers.
@@ -518,7 +541,7 @@ fn panel(s: &mut String, class: TransformClass, points: &[Point], axes: &Axes) -
     // Labels: the peers, then the fronts from fast to slow.
     let mut labelled: Vec<usize> = (0..points.len()).filter(|&i| points[i].peer()).collect();
     let mut fronts: Vec<usize> = all.iter().chain(&outward).copied().collect();
-    fronts.sort_by(|&a, &b| points[a].ns.total_cmp(&points[b].ns));
+    fronts.sort_by(|&a, &b| points[a].ns.total_cmp(&points[b].ns).then(a.cmp(&b)));
     fronts.dedup();
     labelled.extend(fronts.into_iter().filter(|i| !points[*i].peer()));
     let mut unplaced = 0;
@@ -571,71 +594,57 @@ fn panel(s: &mut String, class: TransformClass, points: &[Point], axes: &Axes) -
     unplaced
 }
 
+/// What a legend entry shows.
+#[derive(Clone, Copy)]
+enum Swatch {
+    /// A marker on a front and one off it.
+    Nearest,
+    Outward,
+    Peer,
+    /// A front's line, in its colour.
+    Front(&'static str),
+    /// A peer's dashed line.
+    Dashed,
+}
+
 /// The legend: the markers and lines of the panels, in two rows.
 fn legend(s: &mut String, x0: f64, y0: f64) {
-    let items: [[(&str, &str); 3]; 2] = [
+    let items: [[(Swatch, &str); 3]; 2] = [
         [
-            ("nearest", "Nearest kernel"),
-            ("outward", "Outward kernel (contains the exact box)"),
-            ("peer", "peer: the loop a user would write"),
+            (Swatch::Nearest, "Nearest kernel"),
+            (Swatch::Outward, "Outward kernel (contains the exact box)"),
+            (Swatch::Peer, "peer: the loop a user would write"),
         ],
         [
-            ("front", "Pareto front: no other point both faster and more accurate"),
-            ("outward front", "Pareto front of the Outward kernels"),
-            ("no error", "peer whose error the oracle cannot judge"),
+            (
+                Swatch::Front(NEAREST),
+                "Pareto front: no other point both faster and more accurate",
+            ),
+            (
+                Swatch::Front(OUTWARD),
+                "Pareto front of the Outward kernels",
+            ),
+            (Swatch::Dashed, "peer whose error the oracle cannot judge"),
         ],
     ];
     for (row, entries) in items.iter().enumerate() {
         let y = y0 + 22.0 * row as f64;
         let mut x = x0;
-        for (key, what) in entries {
-            match *key {
-                "nearest" => write!(
-                    s,
-                    r#"<circle cx="{:.1}" cy="{y:.1}" r="{LARGE}" fill="{NEAREST}"/><circle cx="{:.1}" cy="{y:.1}" r="{SMALL}" fill="{NEAREST_PALE}"/>"#,
-                    x + 6.0,
-                    x + 20.0
+        for &(swatch, what) in entries {
+            s.push_str(&match swatch {
+                Swatch::Nearest => {
+                    circle(x + 6.0, y, LARGE, NEAREST, "") + &circle(x + 20.0, y, SMALL, NEAREST_PALE, "")
+                }
+                Swatch::Outward => {
+                    square(x + 6.0, y, LARGE, OUTWARD, "") + &square(x + 20.0, y, SMALL, OUTWARD_PALE, "")
+                }
+                Swatch::Peer => diamond(x + 12.0, y),
+                Swatch::Front(color) => format!(
+                    r#"<line x1="{x:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{color}" stroke-width="1.6"/>"#,
+                    x + 26.0
                 ),
-                "outward" => write!(
-                    s,
-                    r#"<rect x="{:.1}" y="{:.1}" width="{}" height="{}" fill="{OUTWARD}"/><rect x="{:.1}" y="{:.1}" width="{}" height="{}" fill="{OUTWARD_PALE}"/>"#,
-                    x + 6.0 - LARGE,
-                    y - LARGE,
-                    2.0 * LARGE,
-                    2.0 * LARGE,
-                    x + 20.0 - SMALL,
-                    y - SMALL,
-                    2.0 * SMALL,
-                    2.0 * SMALL
-                ),
-                "peer" => write!(
-                    s,
-                    r#"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1} {:.1},{:.1}" fill="black"/>"#,
-                    x + 12.0,
-                    y - PEER,
-                    x + 12.0 + PEER,
-                    y,
-                    x + 12.0,
-                    y + PEER,
-                    x + 12.0 - PEER,
-                    y
-                ),
-                "front" | "outward front" => write!(
-                    s,
-                    r#"<line x1="{x:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{}" stroke-width="1.6"/>"#,
-                    x + 26.0,
-                    if *key == "front" { NEAREST } else { OUTWARD }
-                ),
-                _ => write!(
-                    s,
-                    r##"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="#333" stroke-dasharray="5 4"/>"##,
-                    x + 12.0,
-                    y - 8.0,
-                    x + 12.0,
-                    y + 8.0
-                ),
-            }
-            .unwrap();
+                Swatch::Dashed => dashed(x + 12.0, y - 8.0, y + 8.0),
+            });
             text(s, (x + 32.0, y + 4.0), FONT, "start", "", what);
             x += 32.0 + text_size(what.chars().count(), FONT).0 + 28.0;
         }
@@ -664,9 +673,8 @@ pub fn svg(rows: &[Row], best: &str) -> (String, usize) {
         .collect();
     // One speed axis for every panel, so that the classes compare at a glance.
     let speeds = panels.iter().flat_map(|(_, p)| p.iter().map(|p| p.ns));
-    let (fastest, slowest) = speeds.fold((f64::MAX, 0.0f64), |(lo, hi), ns| {
-        (lo.min(ns), hi.max(ns))
-    });
+    let (fastest, slowest) =
+        speeds.fold((f64::MAX, 0.0f64), |(lo, hi), ns| (lo.min(ns), hi.max(ns)));
     let x = (nice_below(fastest / 1.1), nice_above(slowest * 1.1));
 
     let rows_of_panels = TransformClass::ALL.len().div_ceil(COLUMNS);

@@ -2,10 +2,10 @@
 
 use std::fmt::Write as _;
 
-use bvkit::{Backend, Rounding};
+use bvkit::{Backend, Method, Rounding};
 
 use crate::measure::{
-    ACCURACY_CLASSES, CACHE, CACHE_RUNS, CASES, DRAM, DRAM_RUNS, Kind, Layout, Row, SCALAR,
+    ACCURACY_CLASSES, CACHE, CACHE_RUNS, CASES, DRAM, DRAM_RUNS, Kind, Layout, Peer, Row, SCALAR,
     TransformClass, cases_per_kernel,
 };
 
@@ -39,7 +39,7 @@ pub fn few_ulps(rows: &[Row], class: TransformClass) -> Option<&Row> {
 
 /// A batch size in words: "4096 boxes", "4M boxes".
 pub fn boxes(n: usize) -> String {
-    if n >= 1 << 20 && n % (1 << 20) == 0 {
+    if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
         format!("{}M boxes", n >> 20)
     } else {
         format!("{n} boxes")
@@ -151,9 +151,10 @@ pub fn summary(rows: &[Row]) -> String {
         for rounding in Rounding::ALL {
             write!(s, "| {} | {} |", class.name(), rounding.name()).unwrap();
             for layout in Layout::ALL {
-                let best = fastest(kernels(rows, class).filter(|r| {
-                    r.layout == layout && r.kernel().unwrap().1 == rounding
-                }));
+                let best = fastest(
+                    kernels(rows, class)
+                        .filter(|r| r.layout == layout && r.kernel().unwrap().1 == rounding),
+                );
                 let cell = best.map_or("–".into(), |r| {
                     let backend = if r.backend == SCALAR { " (scalar)" } else { "" };
                     format!(
@@ -175,14 +176,16 @@ pub fn summary(rows: &[Row]) -> String {
 /// The speed targets, measured in this run (the rows that are missing are left
 /// out, e.g. on a CPU without SIMD).
 pub fn targets(rows: &[Row], best: Backend) -> String {
-    let find = |class: TransformClass, name: &str, layout: Layout, backend: &str| {
+    let find = |class: TransformClass, kind: Kind, layout: Layout, backend: &str| {
         rows.iter().find(|r| {
-            r.class == class && r.name() == name && r.layout == layout && r.backend == backend
+            r.class == class && r.kind == kind && r.layout == layout && r.backend == backend
         })
     };
     let b = best.name();
-    let nearest = |class| find(class, "abs-matrix nearest", Layout::Aosoa, b);
-    let roofline = |class| find(class, "memory roofline", Layout::Aosoa, "roofline");
+    let abs = |rounding| Kind::Kernel(Method::AbsMatrix, rounding);
+    let parry = |class| find(class, Kind::Peer(Peer::Parry), Layout::Aos, "peer");
+    let nearest = |class| find(class, abs(Rounding::Nearest), Layout::Aosoa, b);
+    let roofline = |class| find(class, Kind::Roofline, Layout::Aosoa, "roofline");
     use TransformClass::{Affine3, Rigid3, Translation3};
     let figures = [
         (
@@ -192,25 +195,23 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
         ),
         (
             "speed-up over the parry3d loop, in cache".into(),
-            find(
-                Affine3,
-                "parry3d Aabb::transform_by (rigid)",
-                Layout::Aos,
-                "peer",
-            )
-            .zip(nearest(Affine3))
-            .map(|(p, n)| format!("{:.1}x", p.ns_cache / n.ns_cache)),
+            parry(Affine3)
+                .zip(nearest(Affine3))
+                .map(|(p, n)| format!("{:.1}x", p.ns_cache / n.ns_cache)),
             ">= 10x",
         ),
         (
             "Outward / Nearest (abs-matrix AoSoA), in cache".into(),
-            find(Affine3, "abs-matrix outward", Layout::Aosoa, b)
+            find(Affine3, abs(Rounding::Outward), Layout::Aosoa, b)
                 .zip(nearest(Affine3))
                 .map(|(o, n)| format!("{:.2}x", o.ns_cache / n.ns_cache)),
             "<= 1.2x",
         ),
         (
-            format!("abs-matrix nearest AoSoA / memory roofline, {}", boxes(DRAM)),
+            format!(
+                "abs-matrix nearest AoSoA / memory roofline, {}",
+                boxes(DRAM)
+            ),
             nearest(Affine3)
                 .zip(roofline(Affine3))
                 .map(|(n, r)| format!("{:.2}x", n.ns_dram / r.ns_dram)),
@@ -239,8 +240,8 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
         ),
         (
             "parry3d loop / rigid AoS (`&[Rigid3]`), in cache".into(),
-            find(Rigid3, "parry3d Aabb::transform_by", Layout::Aos, "peer")
-                .zip(find(Rigid3, "abs-matrix nearest", Layout::Aos, b))
+            parry(Rigid3)
+                .zip(find(Rigid3, abs(Rounding::Nearest), Layout::Aos, b))
                 .map(|(p, r)| format!("{:.2}x", p.ns_cache / r.ns_cache)),
             ">= 8x",
         ),
