@@ -25,12 +25,12 @@ fn kernels(rows: &[Row], class: TransformClass) -> impl Iterator<Item = &Row> {
 }
 
 /// The fastest kernel of `class` that must contain: Outward rounding.
-pub fn must_contain(rows: &[Row], class: TransformClass) -> Option<&Row> {
+fn must_contain(rows: &[Row], class: TransformClass) -> Option<&Row> {
     fastest(kernels(rows, class).filter(|r| r.kernel().unwrap().1 == Rounding::Outward))
 }
 
 /// The fastest Nearest kernel of `class` whose worst error is at most [`FEW_ULPS`].
-pub fn few_ulps(rows: &[Row], class: TransformClass) -> Option<&Row> {
+fn few_ulps(rows: &[Row], class: TransformClass) -> Option<&Row> {
     fastest(kernels(rows, class).filter(|r| {
         r.kernel().unwrap().1 == Rounding::Nearest
             && r.accuracy.is_some_and(|a| a.worst_error_us <= FEW_ULPS)
@@ -38,7 +38,7 @@ pub fn few_ulps(rows: &[Row], class: TransformClass) -> Option<&Row> {
 }
 
 /// A batch size in words: "4096 boxes", "4M boxes".
-pub fn boxes(n: usize) -> String {
+fn boxes(n: usize) -> String {
     if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
         format!("{}M boxes", n >> 20)
     } else {
@@ -261,7 +261,7 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
 pub fn method(best: Backend, rows: &[Row]) -> String {
     let (kernels, peers, rooflines) = counts(rows);
     format!(
-        "## How this was measured\n\nBest backend: {best:?} (of {:?}); the batch kernels also run on the scalar backend. ns/box: the median of {CACHE_RUNS} runs over {} (inputs and outputs in cache) and of {DRAM_RUNS} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({CASES} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured. The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
+        "## How this was measured\n\nBest backend: {best:?} (of {:?}); the 3D affine, 2D rigid and 2D affine batch kernels also run on the scalar backend. ns/box: the median of {CACHE_RUNS} runs over {} (inputs and outputs in cache) and of {DRAM_RUNS} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({CASES} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured (the plot draws it as a dashed line at its speed, in the 3D rigid panel). The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
         Backend::supported(),
         boxes(CACHE),
         boxes(DRAM),
