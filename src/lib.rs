@@ -42,10 +42,10 @@
 //!   1.6 ns affine, 4.3 against 2.4 rigid); at 4M boxes memory hides it.
 //! - **A few ulps are fine** (debug drawing, level of detail, sorting): [`Rounding::Nearest`],
 //!   each face within `γ(n)·S` of the exact face, on either side.
-//! - **The method**: [`Method::AbsMatrix`] in 3D (the fastest Outward kernel of every 3D
-//!   class in the trade report), [`Method::SignSelect`] in 2D and where the abs-matrix
-//!   pad is too wide (its Outward pad is two `u·S` narrower), [`Method::Naive`] only as the
-//!   baseline to compare against.
+//! - **The method**: [`Method::AbsMatrix`] on AoSoA blocks, the fastest kernel there for
+//!   every 3D class and both roundings in the trade report; [`Method::SignSelect`] in 2D,
+//!   and for one box or slices of the scaled and affine classes, where it measured fastest
+//!   with Outward and its pad is two `u·S` narrower; [`Method::Naive`] only as the baseline.
 //!
 //! ## 3. The layout: how your data is stored
 //!
