@@ -72,6 +72,11 @@ fn bench(c: &mut Criterion) {
         g.bench_function("roofline/aosoa-rigid", |b| {
             b.iter(|| roofline_blocks(black_box(&braw), black_box(&rraw), &mut oraw))
         });
+        // Non-temporal stores (issue 9): kept in bvkit only if this beats the plain roofline.
+        #[cfg(target_arch = "x86_64")]
+        g.bench_function("roofline/aosoa-stream", |b| {
+            b.iter(|| roofline_blocks_streaming(black_box(&braw), black_box(&xraw), &mut o8))
+        });
         g.bench_function("peer/glam-abs-matrix", |b| {
             b.iter(|| glam_abs_matrix(black_box(boxes), black_box(&s.affine), &mut oa))
         });

@@ -207,6 +207,44 @@ pub fn roofline_blocks<const F: usize>(
     }
 }
 
+/// [`roofline_blocks`] with non-temporal stores: each output block goes to memory through
+/// `_mm_stream_ps`, bypassing the caches, then one `_mm_sfence`. The experiment behind the
+/// question whether bvkit should stream outputs larger than the last-level cache: a kernel
+/// can only gain what this roofline gains over the plain one.
+#[cfg(target_arch = "x86_64")]
+pub fn roofline_blocks_streaming<const F: usize>(
+    boxes: &[[[f32; 8]; 6]],
+    xfs: &[[[f32; 8]; F]],
+    out: &mut [bvkit::Aabb3x8],
+) {
+    use std::arch::x86_64::{_mm_loadu_ps, _mm_sfence, _mm_stream_ps};
+    for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
+        let mut m = [0.0f32; 8];
+        for field in x {
+            for k in 0..8 {
+                m[k] += field[k];
+            }
+        }
+        for n in 0..6 {
+            let mut face = [0.0f32; 8];
+            for k in 0..8 {
+                face[k] = b[n][k] + m[k];
+            }
+            let dst = o.fields[n].as_mut_ptr();
+            // SAFETY: SSE is part of the x86-64 baseline; `dst` and `dst + 4` point into
+            // `o.fields[n]`, eight floats of a 32-byte-aligned block, so both halves are
+            // 16-byte aligned, in bounds and exclusively borrowed; `face` has 8 floats.
+            unsafe {
+                _mm_stream_ps(dst, _mm_loadu_ps(face.as_ptr()));
+                _mm_stream_ps(dst.add(4), _mm_loadu_ps(face.as_ptr().add(4)));
+            }
+        }
+    }
+    // SAFETY: a store fence, SSE (baseline): orders the streamed stores before any later
+    // store, as the plain roofline's stores are ordered.
+    unsafe { _mm_sfence() };
+}
+
 /// The fields of AoSoA blocks as plain arrays, for [`roofline_blocks`].
 pub fn raw<T, const F: usize>(
     blocks: &[T],
