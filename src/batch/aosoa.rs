@@ -254,6 +254,25 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
             }
         }
     }
+    #[inline(always)]
+    fn store_streaming<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
+    ) {
+        // Whole 8-lane blocks only: three full cache lines per 3D block, nothing to merge.
+        if count == 8 && L::WIDTH == 8 {
+            let fields = self[i / 8].fields.as_mut();
+            for a in 0..N {
+                min.0[a].store_streaming(&mut fields[a]);
+                max.0[a].store_streaming(&mut fields[N + a]);
+            }
+        } else {
+            self.store(i, count, min, max);
+        }
+    }
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         let fields = self[i / 8].fields.as_mut();
         for a in 0..N {
@@ -326,6 +345,16 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
         max: Vector<L, N>,
     ) {
         self.as_mut_slice().store(i, count, min, max);
+    }
+    #[inline(always)]
+    fn store_streaming<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        min: Vector<L, N>,
+        max: Vector<L, N>,
+    ) {
+        self.as_mut_slice().store_streaming(i, count, min, max);
     }
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);

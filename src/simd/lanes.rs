@@ -24,6 +24,13 @@ pub trait LaneArray: Lane {
     fn load(src: &[f32]) -> Self;
     /// Writes the lanes to `dst[..WIDTH]` (one vector store).
     fn store(self, dst: &mut [f32]);
+    /// [`LaneArray::store`] past the caches (non-temporal), where the lanes fill whole
+    /// 16-byte-aligned vectors; otherwise an ordinary store. The caller fences
+    /// ([`super::store_fence`]) before the batch returns.
+    #[inline(always)]
+    fn store_streaming(self, dst: &mut [f32]) {
+        self.store(dst);
+    }
     /// True when any lane is not zero (NaN included).
     fn any_nonzero(self) -> bool;
     /// Bit `k` set where lane `k` is not zero (NaN included).
@@ -179,6 +186,28 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
     #[inline(always)]
     fn store(self, dst: &mut [f32]) {
         dst[..W].copy_from_slice(&self.0);
+    }
+    #[inline(always)]
+    fn store_streaming(self, dst: &mut [f32]) {
+        let dst = &mut dst[..W];
+        #[cfg(target_arch = "x86_64")]
+        if W % 4 == 0 && dst.as_ptr().align_offset(16) == 0 {
+            use core::arch::x86_64::{_mm_loadu_ps, _mm_stream_ps};
+            for q in 0..W / 4 {
+                #[allow(unsafe_code)]
+                // SAFETY: SSE is part of the x86-64 baseline; `dst` holds `W` floats and is
+                // 16-byte aligned (checked), so each quarter `4q..4q + 4` is an aligned,
+                // in-bounds, exclusively borrowed target; the source is `self.0[4q..]`.
+                unsafe {
+                    _mm_stream_ps(
+                        dst.as_mut_ptr().add(4 * q),
+                        _mm_loadu_ps(self.0.as_ptr().add(4 * q)),
+                    );
+                }
+            }
+            return;
+        }
+        dst.copy_from_slice(&self.0);
     }
     #[inline(always)]
     fn any_nonzero(self) -> bool {

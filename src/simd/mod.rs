@@ -175,6 +175,19 @@ fn run_avx512<J: Job, L: LaneArray>(job: J) {
     job.run::<L>();
 }
 
+/// Orders every non-temporal store before the stores that follow ([`LaneArray::store_streaming`]
+/// is weakly ordered): the last step of a batch that streamed its output.
+#[inline(always)]
+pub(crate) fn store_fence() {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: `_mm_sfence` only orders stores; its requirement, SSE, is part of the x86-64
+    // baseline.
+    unsafe {
+        core::arch::x86_64::_mm_sfence();
+    }
+}
+
 /// Asks the CPU to start loading the cache line of `x`: a hint, with no effect on any
 /// result. Scattered updates issue it a few objects ahead, since their kernels are too long
 /// for the out-of-order window to overlap more than one or two cache misses.
