@@ -191,7 +191,7 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
     fn store_streaming(self, dst: &mut [f32]) {
         let dst = &mut dst[..W];
         #[cfg(target_arch = "x86_64")]
-        if W % 4 == 0 && dst.as_ptr().align_offset(16) == 0 {
+        if W.is_multiple_of(4) && dst.as_ptr().align_offset(16) == 0 {
             use core::arch::x86_64::{_mm_loadu_ps, _mm_stream_ps};
             for q in 0..W / 4 {
                 #[allow(unsafe_code)]
