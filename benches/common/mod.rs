@@ -225,14 +225,14 @@ pub fn roofline_blocks_streaming<const F: usize>(
                 m[k] += field[k];
             }
         }
-        for n in 0..6 {
+        for (src, dst) in b.iter().zip(&mut o.fields) {
             let mut face = [0.0f32; 8];
             for k in 0..8 {
-                face[k] = b[n][k] + m[k];
+                face[k] = src[k] + m[k];
             }
-            let dst = o.fields[n].as_mut_ptr();
+            let dst = dst.as_mut_ptr();
             // SAFETY: SSE is part of the x86-64 baseline; `dst` and `dst + 4` point into
-            // `o.fields[n]`, eight floats of a 32-byte-aligned block, so both halves are
+            // one field of `o`, eight floats of a 32-byte-aligned block, so both halves are
             // 16-byte aligned, in bounds and exclusively borrowed; `face` has 8 floats.
             unsafe {
                 _mm_stream_ps(dst, _mm_loadu_ps(face.as_ptr()));
