@@ -58,7 +58,7 @@
 //! | `Vec<Aabb3>` and `Vec<Rigid3>` | `&local`, `&poses` | 9.2 |
 //! | AoSoA blocks of eight ([`Aabb3x8`], [`Rigid3x8`]) | `&local8`, `&poses8` | 4.3 |
 //! | columns ([`AabbSoa`], [`Soa<Rigid3>`](Soa)) | `&local`, `&poses` | 4.1 |
-//! | one pose for many boxes | `&pose` | |
+//! | one pose for many boxes | `&pose` | not measured |
 //!
 //! A broadphase calls [`Batch::update`] instead: the same kernels, and only the fat boxes
 //! whose object left them are rewritten (see [`broadphase`]).

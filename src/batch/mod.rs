@@ -333,9 +333,9 @@ impl Batch {
     /// Outputs larger than this many bytes of box fields (32 MiB: about 1.4M 3D boxes,
     /// beyond the last-level cache of most CPUs) are written past the caches when they are
     /// AoSoA blocks: non-temporal stores of whole blocks, then a store fence. The bits are
-    /// the same; at 4M boxes the AoSoA roofline measured 0.83× with them. A broadphase
-    /// that reads the boxes back at once gains nothing from them staying in a cache they
-    /// do not fit.
+    /// the same; at 4M affine boxes abs-matrix Nearest measured 4.15 against 5.16 ns per
+    /// box with them. A consumer that reads the boxes back gains nothing from them staying
+    /// in a cache they do not fit.
     pub const NON_TEMPORAL_BYTES: usize = 32 << 20;
 
     /// A batch on the fastest backend of this CPU ([`Backend::detect`]).

@@ -132,9 +132,9 @@ pub(crate) trait Job {
 }
 
 /// Runs `job` on `backend`, which the caller has checked is supported; `fused` lets the
-/// AVX2 and AVX-512 lanes fuse multiply-adds (with the `std` feature only). Unfused, every backend does the same
-/// arithmetic as the scalar reference (`wide` then runs the baseline lanes, since its
-/// fusing is fixed at compile time).
+/// AVX2 and AVX-512 lanes fuse multiply-adds (with the `std` feature only). Unfused, every
+/// backend does the same arithmetic as the scalar reference (`wide` then runs the baseline
+/// lanes, since its fusing is fixed at compile time).
 #[allow(unsafe_code)] // the one place: calling the `#[target_feature]` wrappers
 pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     debug_assert!(backend.is_supported());
