@@ -7,7 +7,7 @@
 //! matrices) is answered by [`crate::extended`].
 
 use crate::lane::{Axes, Lane};
-use crate::method::{Method, TINY_PAD, UNIT_ROUNDOFF};
+use crate::method::{Method, REACH_FLOOR, UNIT_ROUNDOFF};
 use crate::transform::MapKernel;
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.
@@ -43,8 +43,8 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 }
 
 /// Arvo's abs-matrix method in doubled form: `2c = lo + hi`, `2e = hi − lo`,
-/// `2c' = M·2c + 2t`, `2e' = |M|·2e`, faces `(2c' ∓ 2e') / 2`; padded outward by `k·u·S +
-/// TINY_PAD` when `pad_order` is `Some(k)`.
+/// `2c' = M·2c + 2t`, `2e' = |M|·2e`, faces `(2c' ∓ 2e') / 2`; padded outward by
+/// `k·u·(S + 2^-80)` when `pad_order` is `Some(k)`.
 ///
 /// Halving last keeps subnormal boxes exact up to the final rounding (halving first
 /// would flush the half-width of a one-ulp subnormal box to zero). Doubling can overflow
@@ -53,15 +53,17 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 ///
 /// Error: `2c` and `2e` round once each, the dot products of `N` terms (onto `2t`) at most
 /// `N + 1` times, the final difference once; halving is exact above the subnormal range
-/// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo_j|, |hi_j|)` the face
+/// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo|, |hi|)` the face
 /// error is at most `γ(N+3)·S + TINY_ERROR`.
 ///
-/// The pad reuses what the method has: `2S = |2t| + |M|·(|2c| + 2e)` is `N` more
+/// The pad reuses what the method has: `2S' = |2t| + 2^-79 + |M|·(|2c| + 2e)` is `N` more
 /// multiply-adds on the `|M|` of `2e'`, applied to `2c' ∓ 2e'` before the halving.
 /// The computed `|2c| + 2e` is at least `(1 − u)²·2·max(|lo|, |hi|)` and the dot product of
-/// positive terms loses at most `γ(N + 1)`, so the computed `2S` is at least
-/// `2S·(1 − γ(N + 3))`; the argument of [`outward_pad`] then applies with doubled terms
-/// (`2·TINY_PAD` covers the doubled `TINY_ERROR`, the pad's rounding and the halving).
+/// positive terms loses at most `γ(N + 1)`, so the computed `2S'` is at least
+/// `2S'·(1 − γ(N + 3))`; the argument of [`outward_pad`] then applies with doubled terms.
+/// The doubled pad is at least `2^-79·k·u >= 2^-101` (`k >= 7`), so on normal-range input
+/// `2c' ∓ 2e' ∓ pad` is a multiple of `2^-125` and its half a multiple of `2^-126`: zero
+/// or normal (see [`outward_pad`]).
 #[inline(always)]
 pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     a: &AffineLanes<V, N>,
@@ -81,11 +83,11 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     let (mut min2, mut max2) = (world_center2 - world_extent2, world_center2 + world_extent2);
     if let Some(k) = pad_order {
         let reach2 = center2.abs() + extent2;
-        let mut magnitude2 = t2.abs();
+        let mut magnitude2 = t2.abs() + V::splat(2.0 * REACH_FLOOR);
         for j in 0..N {
             magnitude2 = a.cols[j].abs().mul_add(reach2.axis(j), magnitude2);
         }
-        let pad2 = magnitude2.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(2.0 * TINY_PAD));
+        let pad2 = magnitude2 * V::splat(k as f32 * UNIT_ROUNDOFF);
         (min2, max2) = (min2 - pad2, max2 + pad2);
     }
     let half = V::splat(0.5);
@@ -143,14 +145,25 @@ pub(crate) fn sign_branch_rigid2<L: Lane>(
     )
 }
 
-/// The Outward pad `k·u·S + TINY_PAD`, with `S_i = |t_i| + sum_j |m_ij|·max(|lo_j|, |hi_j|)`
+/// The Outward pad `k·u·(S + 2^-80)`, with `S_i = |t_i| + sum_j |m_ij|·max(|lo_j|, |hi_j|)`
 /// computed in the same lanes (`max(hi, −lo)` equals `max(|lo|, |hi|)` when `lo <= hi`).
 ///
-/// Why `k = n + 2` suffices for a Nearest bound `γ(n)·S`: the computed `S` (positive
-/// terms only) is at least `S·(1 − γ(N+1))`, the pad's own product rounds once, and the
-/// padded face `fl(face ∓ pad)` rounds once more by at most `u·(|face| + pad)`. Hence
-/// `pad − error − rounding >= (k − n − 1)·u·S − O(u²·S) > 0`; the absolute terms are
-/// covered by `TINY_PAD >= 2·TINY_ERROR + 2^-150`.
+/// Why `k = n + 2` suffices for a Nearest bound `γ(n)·S + TINY_ERROR`: the computed
+/// `S + 2^-80` (positive terms only) is at least `(S + 2^-80)·(1 − γ(N+1))` (less `N·2^-150`
+/// if products underflow), the pad's own product rounds once, and the padded face
+/// `fl(face ∓ pad)` rounds once more by at most `u·(|face| + pad)` (and is exact if
+/// subnormal). Hence `pad − error − rounding >= (k − n − 1)·u·S − O(u²·S) > 0` for the
+/// relative part, and the absolute part `k·u·2^-80 >= 2^-102` covers `TINY_ERROR = 2^-148`
+/// and the underflow of `S` many times over.
+///
+/// Why nothing is subnormal on normal-range input (every nonzero value multiplied at least
+/// `2^-32`; see [`crate::method`]): such a value is a multiple of `2^-55`, so every exact
+/// product of two is a multiple of `2^-110`, and so is every exact sum of those. Rounding
+/// keeps a multiple of `2^-110` one (above `2^-87` the `f32` spacing is a multiple of
+/// `2^-110`; below, the value is representable), so every face is zero or at least
+/// `2^-110`. The pad is at least `k·u·2^-80 >= 2^-102`, so its spacing is a multiple of
+/// `2^-125` and so is `face ∓ pad`: zero or normal. The constant `2^-80` itself is normal,
+/// and FTZ and DAZ change no bit of the result.
 #[inline(always)]
 pub(crate) fn outward_pad<V: Axes, const N: usize>(
     a: &AffineLanes<V, N>,
@@ -159,11 +172,11 @@ pub(crate) fn outward_pad<V: Axes, const N: usize>(
     k: u32,
 ) -> V {
     let magnitude = hi.max(-lo);
-    let mut s = a.t.abs();
+    let mut s = a.t.abs() + V::splat(REACH_FLOOR);
     for j in 0..N {
         s = a.cols[j].abs().mul_add(magnitude.axis(j), s);
     }
-    s.mul_add(V::splat(k as f32 * UNIT_ROUNDOFF), V::splat(TINY_PAD))
+    s * V::splat(k as f32 * UNIT_ROUNDOFF)
 }
 
 /// One box through one method, round to nearest.
@@ -241,17 +254,21 @@ fn two_sum_error<V: Lane>(a: V, b: V, s: V) -> V {
     (a - a_virtual) + (b - b_virtual)
 }
 
-/// The next `f32` below `x` (finite `x`), in float arithmetic: `x − (|x|·c + 2^-149)` with
-/// `c = 2^-24·(1 + 2^-23)`.
+/// The next `f32` below `x` (finite `x`), or lower, in float arithmetic: `x − (|x|·c +
+/// 2^-104)` with `c = 2^-24·(1 + 2^-23)`.
 ///
 /// For `x = ±m·2^k`, `m ∈ [1, 2)`, the ulp is `2^(k−23)` and `|x|·c` rounds to a value in
 /// `(ulp/2, ulp·(1 + 2^-23)]`: more than half an ulp, so round to nearest moves `x` down
 /// (to `x − ulp/2` when `x = 2^k > 0`, where the spacing below halves), and less than one
-/// and a half, so it moves by one step. Below the normal range the `2^-149` is one step.
+/// and a half, so it moves by one step. The normal constant `2^-104` changes neither bound
+/// when the ulp is at least `2^-102` (`|x| >= 2^-79`), where the step is exactly one ulp;
+/// below, the step is at least `2^-104` and moves `x` further down, by at most `2^-103`.
+/// Nothing is subnormal: on normal-range input a nonzero face is at least `2^-55`.
 #[inline(always)]
 fn step_down<V: Lane>(x: V) -> V {
     const C: f32 = UNIT_ROUNDOFF * (1.0 + f32::EPSILON);
-    x - x.abs().mul_add(V::splat(C), V::splat(f32::from_bits(1)))
+    const FLOOR: f32 = REACH_FLOOR * UNIT_ROUNDOFF; // 2^-104
+    x - x.abs().mul_add(V::splat(C), V::splat(FLOOR))
 }
 
 /// The standard rotation matrix of a quaternion `[x, y, z, w]`, as glam's `Mat3::from_quat`
@@ -290,22 +307,21 @@ pub(crate) fn scale_box<V: Lane>(s: V, lo: V, hi: V) -> (V, V) {
 }
 
 /// The Outward pad of a quaternion class: `k·u·S'` with
-/// `S'_i = |t_i| + ρ·(Σ_j max(|lo_j|, |hi_j|) + 2^-125)` over the (already scaled) box.
+/// `S'_i = |t_i| + ρ·(Σ_j max(|lo_j|, |hi_j|) + 2^-80)` over the (already scaled) box.
 ///
 /// Why `k = n + 2` suffices for the Nearest order `n` of [`rotation`] plus the method: as
-/// in [`outward_pad`], the computed `S` is at least `S·(1 − γ(N + 6))` (the box's scaling
+/// in [`outward_pad`], the computed `S'` is at least `S'·(1 − γ(N + 6))` (the box's scaling
 /// and `ρ`'s five roundings included), which the surplus `u·S` of the pad absorbs.
 ///
 /// The absolute part: the Nearest error carries `2ρ·TINY_ERROR = ρ·2^-147`, and the pad's
 /// own rounding and that of the padded face at most `2^-150` each. Folding the absolute
-/// term into `S` as `ρ·2^-125` gives `k·ρ·2^-149 >= 9ρ·2^-149` (every quaternion class has
-/// `k >= 9`), which covers `ρ·2^-147 + 2·2^-150` for `ρ >= 1`, and stays below the documented
-/// `2ρ·TINY_PAD = 16ρ·2^-149`. Written this way nothing is subnormal unless `S` itself is
-/// tiny: a subnormal product (`ρ·2^-146`) costs a microcode assist of ~100 cycles on x86.
+/// term into `S` as `ρ·2^-80` gives `k·ρ·u·2^-80 >= 9ρ·2^-104`, which covers them many times
+/// over, and stays below the documented `2ρ·TINY_PAD = ρ·2^-99`. The pad is at least
+/// `2^-102`, a normal number, so as in [`outward_pad`] nothing is subnormal on
+/// normal-range input.
 #[inline(always)]
 pub(crate) fn rotation_pad<V: Axes>(rho: V, t: V, lo: V, hi: V, k: u32) -> V {
-    const TINY_REACH: f32 = 1.0 / (1u128 << 125) as f32; // 2^-125
     let magnitude = hi.max(-lo);
-    let sum = magnitude.axis(0) + magnitude.axis(1) + magnitude.axis(2) + V::splat(TINY_REACH);
+    let sum = magnitude.axis(0) + magnitude.axis(1) + magnitude.axis(2) + V::splat(REACH_FLOOR);
     rho.mul_add(sum, t.abs()) * V::splat(k as f32 * UNIT_ROUNDOFF)
 }

@@ -18,6 +18,32 @@
 //!
 //! `γ(n) = n·u / (1 − n·u)` with `u = 2^-24` (Higham's constant). Outward faces contain the
 //! exact faces and lie within twice the pad of them.
+//!
+//! ## Subnormal numbers, FTZ and DAZ
+//!
+//! Call an input **normal-range** when every nonzero finite value a kernel multiplies (box
+//! coordinates, translations, matrix entries; the computed entries of `R(q)` and the
+//! scaled box for the quaternion classes) is at least `2^-32` (about `2.3·10^-10`) in
+//! magnitude. Real scenes are: a rotation entry of exactly zero is fine, one of `10^-12`
+//! is not. On normal-range input no kernel reads or produces a subnormal number, on any
+//! path (see [`crate::kernel`] for why), so none pays the microcode assist that Intel
+//! cores take for one, and the results are bit for bit the same whatever the MXCSR modes
+//! flush-to-zero (FTZ) and denormals-are-zero (DAZ) say: every guarantee holds with
+//! either or both set. The pads' absolute parts are normal constants for this reason.
+//!
+//! Outside that range (subnormal inputs, or products below `2^-126`) the default mode
+//! keeps every guarantee, at the CPU's subnormal speed: subnormal inputs take that slower
+//! path. Under FTZ the CPU flushes a result below `2^-126` to zero, an error under
+//! `2^-126` per operation; for the classes with a matrix whose entries are at most `2^16`
+//! in magnitude, the pad's absolute part (at least `2^-102`) covers those errors, so
+//! Outward still contains the exact image of inputs whose values are all normal (tested on
+//! boxes in the lowest normal binades). A translation's face whose sum underflows is
+//! flushed without a trace of its rounding error and can miss by less than `2^-126`.
+//! Under DAZ the CPU reads a subnormal input as zero: the result then bounds the box and
+//! map with those values replaced by zero, which can miss the exact image of the given
+//! values by about `2^-126·(1 + Σ_j |m_ij|)` per axis.
+
+use crate::math::pow2;
 
 /// Unit roundoff of `f32` round-to-nearest: `u = 2^-24`.
 pub const UNIT_ROUNDOFF: f32 = 1.0 / 16_777_216.0;
@@ -25,12 +51,22 @@ pub const UNIT_ROUNDOFF: f32 = 1.0 / 16_777_216.0;
 /// Absolute error allowance for gradual underflow in a Nearest result: `2^-148`.
 ///
 /// Each product whose result is subnormal may be off by half the smallest subnormal,
-/// `2^-150`; no kernel forms more than four such products per face.
+/// `2^-150`; no kernel forms more than four such products per face. On normal-range inputs
+/// (see [`Rounding::Outward`]) no kernel forms a subnormal value, so this term is never used
+/// there; it is a bound, never an operand.
 pub const TINY_ERROR: f32 = f32::from_bits(2); // 2 * 2^-149
 
-/// Absolute part of the Outward pad, `2^-146`: covers [`TINY_ERROR`] with room for the
-/// underflow of the pad's own computation.
-pub const TINY_PAD: f32 = f32::from_bits(8); // 8 * 2^-149
+/// A bound on the absolute part of every Outward pad: `2^-100`, about `8·10^-31`.
+///
+/// Every pad is `k·u·(S + 2^-80)` (`k <= 16`): its absolute part `k·u·2^-80` is a normal
+/// number, so no pad feeds a subnormal operand to the arithmetic, and DAZ cannot zero it.
+pub const TINY_PAD: f32 = pow2(-100) as f32;
+
+/// The reach every pad adds to its magnitude `S`: `2^-80`, so that every pad `k·u·(S +
+/// 2^-80)` is at least `4·2^-24·2^-80 = 2^-102`, a normal number whose ulp (at least
+/// `2^-125`) makes the padded face of a normal-range input zero or normal (see
+/// [`crate::kernel`]).
+pub(crate) const REACH_FLOOR: f32 = pow2(-80) as f32;
 
 /// Higham's `γ(n) = n·u / (1 − n·u)`: the relative error bound of `n` chained roundings.
 #[inline]

@@ -223,6 +223,38 @@ pub trait Exactly<const N: usize>: core::fmt::Debug {
     where
         Self: Sized;
 
+    /// The same problem with the box and the translation scaled by `f` (a power of two).
+    fn scaled_box(&self, f: f32) -> Self
+    where
+        Self: Sized;
+
+    /// The values a kernel multiplies that are not map parameters (the scaled box of a
+    /// quaternion class, the computed entries of `R(q)`); none beyond the inputs here.
+    fn derived_values(&self) -> Vec<f32> {
+        Vec::new()
+    }
+
+    /// Every nonzero finite value a kernel multiplies is at least `2^-32`: bvkit's
+    /// normal-range inputs, on which no kernel forms a subnormal number.
+    fn normal_range(&self) -> bool {
+        let least = 1.0 / 4_294_967_296.0; // 2^-32
+        self.map_values()
+            .into_iter()
+            .chain(self.lo())
+            .chain(self.hi())
+            .chain(self.derived_values())
+            .all(|x| x == 0.0 || !x.is_finite() || x.abs() >= least)
+    }
+
+    /// No input is subnormal.
+    fn all_normal(&self) -> bool {
+        self.map_values()
+            .into_iter()
+            .chain(self.lo())
+            .chain(self.hi())
+            .all(|x| x == 0.0 || !x.is_finite() || x.is_normal())
+    }
+
     /// True when the box holds no real point.
     fn is_empty(&self) -> bool {
         let (lo, hi) = (self.lo(), self.hi());
@@ -303,6 +335,15 @@ impl<const N: usize> Exactly<N> for Problem<N> {
     }
     fn with_box(&self, lo: [f32; N], hi: [f32; N]) -> Self {
         Problem { lo, hi, ..*self }
+    }
+    fn scaled_box(&self, f: f32) -> Self {
+        let by = |v: [f32; N]| v.map(|x| x * f);
+        Problem {
+            lo: by(self.lo),
+            hi: by(self.hi),
+            t: by(self.t),
+            ..*self
+        }
     }
 }
 
@@ -387,6 +428,21 @@ impl Exactly<3> for QuatProblem {
     }
     fn with_box(&self, lo: [f32; 3], hi: [f32; 3]) -> Self {
         QuatProblem { lo, hi, ..*self }
+    }
+    fn scaled_box(&self, f: f32) -> Self {
+        let by = |v: [f32; 3]| v.map(|x| x * f);
+        QuatProblem {
+            lo: by(self.lo),
+            hi: by(self.hi),
+            t: by(self.t),
+            ..*self
+        }
+    }
+    fn derived_values(&self) -> Vec<f32> {
+        // R(q) as bvkit computes it (glam's formula, unnormalised), and the scaled box.
+        let r = glam::Mat3::from_quat(Quat::from_array(self.q));
+        let scaled = (0..3).flat_map(|j| [self.s[j] * self.lo[j], self.s[j] * self.hi[j]]);
+        r.to_cols_array().into_iter().chain(scaled).collect()
     }
 }
 
