@@ -22,11 +22,7 @@ fn kernels() -> Vec<(Method, Rounding)> {
 }
 
 fn bench(c: &mut Criterion) {
-    let best = Backend::detect();
-    eprintln!(
-        "detected backend: {best:?}; supported: {:?}",
-        Backend::supported()
-    );
+    announce("batch");
     for (n, size) in SIZES {
         let (boxes, xfs, poses) = scene(n, 0x5eed);
         let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));

@@ -53,7 +53,7 @@ fn roofline(
 }
 
 fn bench(c: &mut Criterion) {
-    eprintln!("best backend: {:?}", Backend::detect());
+    announce("broadphase");
     let s = class_scene(N, 0xb70ad);
     let (local, poses) = (&s.boxes, &s.rigid);
     let jumped: Vec<Rigid3> = poses

@@ -59,6 +59,7 @@ fn class<T: Transform3, const F: usize>(
 }
 
 fn bench(c: &mut Criterion) {
+    announce("classes");
     for (n, size) in SIZES {
         let s = class_scene(n, 0xc1a55);
         let (pb, pp) = parry_scene(&s.boxes, &s.poses);

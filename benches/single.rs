@@ -15,6 +15,7 @@ use common::*;
 const LOOP: usize = 1024;
 
 fn bench(c: &mut Criterion) {
+    announce("single");
     let (boxes, xfs, poses) = scene(LOOP, 0x51e);
     let (pb, pp) = parry_scene(&boxes, &poses);
     let boxes2: Vec<Aabb2> = boxes

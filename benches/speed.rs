@@ -1,6 +1,8 @@
 //! Where users call bvkit, in one process: a hand-written glam loop and a parry3d loop,
 //! single-box calls, AoS, SoA and AoSoA batches on the best backend, and the memory
-//! rooflines, at 256 (L1), 1K, 64K and 4M boxes, for affine maps and rigid poses.
+//! rooflines, at 256 (L1), 1K, 64K and 4M boxes, for affine maps and rigid poses; and in
+//! cache (256, 1K) the translation class in every layout against a glam translation loop,
+//! and the 2D classes as AoS slices. The CPU and the backend are printed first.
 //! `cargo bench --bench speed`; `scripts/bench_report.py speed` tabulates a run.
 
 mod common;
@@ -8,10 +10,14 @@ mod common;
 use std::hint::black_box;
 
 use bvkit::{
-    Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rigid3, Rigid3x8,
-    Rounding, Soa,
+    Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Batch, Block8, Method, Rigid2, Rigid3,
+    Rigid3x8, Rounding, Soa, Translation2, Translation3,
 };
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{
+    BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main,
+};
+use glam::{Affine2, Mat2};
 
 use common::*;
 
@@ -30,7 +36,7 @@ const KERNELS: [(Method, Rounding); 4] = [
 ];
 
 fn bench(c: &mut Criterion) {
-    eprintln!("best backend: {:?}", Backend::detect());
+    announce("speed");
     for (n, size) in SIZES {
         let s = class_scene(n, 0x5eed);
         let boxes = &s.boxes;
@@ -115,7 +121,90 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| batch.transform(black_box(&b8), black_box(&r8), &mut o8))
             });
         }
+        if n <= 1 << 10 {
+            classes_in_cache(&mut g, &s);
+        }
         g.finish();
+    }
+}
+
+/// The glam loop a user writes for translations.
+fn glam_translation(boxes: &[Aabb3], xfs: &[Translation3], out: &mut [Aabb3]) {
+    for ((b, t), o) in boxes.iter().zip(xfs).zip(out) {
+        *o = Aabb3::new(b.min + t.0, b.max + t.0);
+    }
+}
+
+/// The translation class in every layout, and the 2D classes as AoS slices, in cache:
+/// rows of the subnormal issue's table (Outward against Nearest, and the glam loop).
+fn classes_in_cache(g: &mut BenchmarkGroup<'_, WallTime>, s: &ClassScene) {
+    let boxes = &s.boxes;
+    let n = boxes.len();
+    let (b8, t8) = (Aabb3x8::pack(boxes), Block8::pack(&s.translation));
+    let (bs, ts) = (AabbSoa::from_slice(boxes), Soa::from_slice(&s.translation));
+    let mut o8 = vec![Aabb3x8::default(); b8.len()];
+    let mut os = AabbSoa::filled(n, Aabb3::EMPTY);
+    let mut oa = vec![Aabb3::EMPTY; n];
+    let boxes2: Vec<Aabb2> = boxes
+        .iter()
+        .map(|b| Aabb2::new(b.min.truncate(), b.max.truncate()))
+        .collect();
+    let rigid2: Vec<Rigid2> = s
+        .rigid
+        .iter()
+        .map(|p| {
+            let (axis, angle) = p.rotation.to_axis_angle();
+            Rigid2::from_angle_translation(angle * axis.z.signum(), p.translation.truncate())
+        })
+        .collect();
+    let translation2: Vec<Translation2> =
+        rigid2.iter().map(|p| Translation2(p.translation)).collect();
+    let affine2: Vec<Affine2> = rigid2
+        .iter()
+        .zip(&s.trs)
+        .map(|(p, t)| Affine2::from_mat2(Mat2::from_diagonal(t.scale.truncate())) * p.to_affine2())
+        .collect();
+    let mut o2 = vec![Aabb2::EMPTY; n];
+
+    g.bench_function("peer/glam-translation", |b| {
+        b.iter(|| glam_translation(black_box(boxes), black_box(&s.translation), &mut oa))
+    });
+    for rounding in Rounding::ALL {
+        let batch = Batch::new(Method::AbsMatrix, rounding);
+        let r = rounding.name();
+        g.bench_function(BenchmarkId::new("single-translation", r), |b| {
+            b.iter(|| {
+                single_loop(
+                    black_box(boxes),
+                    &s.translation,
+                    &mut oa,
+                    Method::AbsMatrix,
+                    rounding,
+                )
+            })
+        });
+        g.bench_function(BenchmarkId::new("aos-translation", r), |b| {
+            b.iter(|| batch.transform(black_box(boxes), black_box(&s.translation), &mut oa))
+        });
+        g.bench_function(BenchmarkId::new("soa-translation", r), |b| {
+            b.iter(|| batch.transform(black_box(&bs), black_box(&ts), &mut os))
+        });
+        g.bench_function(BenchmarkId::new("aosoa-translation", r), |b| {
+            b.iter(|| batch.transform(black_box(&b8), black_box(&t8), &mut o8))
+        });
+        g.bench_function(BenchmarkId::new("aos2-translation", r), |b| {
+            b.iter(|| batch.transform(black_box(&boxes2), black_box(&translation2), &mut o2))
+        });
+    }
+    for (method, rounding) in KERNELS {
+        let kernel = format!("{}/{}", method.name(), rounding.name());
+        let batch = Batch::new(method, rounding);
+        g.bench_function(BenchmarkId::new("aos2-rigid", &kernel), |b| {
+            b.iter(|| batch.transform(black_box(&boxes2), black_box(&rigid2), &mut o2))
+        });
+        g.bench_function(BenchmarkId::new("aos2-affine", &kernel), |b| {
+            b.iter(|| batch.transform(black_box(&boxes2), black_box(&affine2), &mut o2))
+        });
     }
 }
 

@@ -4,6 +4,8 @@
 //! bytes per triangle are printed once before the timings (`examples/trees.rs` prints the
 //! full comparison). `cargo bench --bench trees`.
 
+#[allow(dead_code)]
+mod common;
 #[path = "../tests/trimesh/mod.rs"]
 mod trimesh;
 
@@ -132,6 +134,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
 }
 
 fn bench(c: &mut Criterion) {
+    common::announce("trees");
     scene(
         c,
         "tori",

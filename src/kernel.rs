@@ -227,31 +227,21 @@ impl<V: Axes, const N: usize> MapKernel<V> for AffineLanes<V, N> {
 
 /// A translation: `[lo + t, hi + t]`, every method being the same map.
 ///
-/// Nearest rounds each face once: error at most `u·|face| <= γ(1)·S`. Outward steps a face
-/// one ulp outward only where its sum was inexact, so that it is the exact face rounded
-/// outward. Knuth's TwoSum gives the error `e` with `face + e = lo + t` exactly (no
-/// overflow: the caller checks the result finite); `e < 0` means the rounded lower face
-/// lies above the exact one and must step down, `e > 0` the mirror for the upper face.
+/// Nearest rounds each face once: error at most `u·|face| <= γ(1)·S`. Outward steps every
+/// face one ulp outward ([`step_down`]): a sum rounded to nearest errs by at most half the
+/// spacing of `f32` at the face, and one step outward is at least that much (at a power of
+/// two the spacing on the far side halves, and so does the largest error there). So the
+/// face contains the exact one, within `u·|face| + 2u·|face| + 2^-103 <= 3u·S + TINY_PAD`.
+/// Two operations a face, where finding the exact rounding error (TwoSum) took seven and
+/// spared the step only on exact sums. Under FTZ a sum that underflows is flushed to
+/// zero, and the step from zero (`2^-104`) still contains it.
 #[inline(always)]
 pub(crate) fn translate<V: Lane>(t: V, lo: V, hi: V, outward: bool) -> (V, V) {
     let (min, max) = (lo + t, hi + t);
     if !outward {
         return (min, max);
     }
-    let (e_min, e_max) = (two_sum_error(lo, t, min), two_sum_error(hi, t, max));
-    (
-        e_min.select_nonneg(min, step_down(min)),
-        (-e_max).select_nonneg(max, -step_down(-max)),
-    )
-}
-
-/// Knuth's TwoSum: the exact error `a + b − s` of `s = fl(a + b)`, six additions, valid in
-/// any rounding to nearest without overflow.
-#[inline(always)]
-fn two_sum_error<V: Lane>(a: V, b: V, s: V) -> V {
-    let b_virtual = s - a;
-    let a_virtual = s - b_virtual;
-    (a - a_virtual) + (b - b_virtual)
+    (step_down(min), -step_down(-max))
 }
 
 /// The next `f32` below `x` (finite `x`), or lower, in float arithmetic: `x − (|x|·c +

@@ -34,11 +34,10 @@
 //! Outside that range (subnormal inputs, or products below `2^-126`) the default mode
 //! keeps every guarantee, at the CPU's subnormal speed: subnormal inputs take that slower
 //! path. Under FTZ the CPU flushes a result below `2^-126` to zero, an error under
-//! `2^-126` per operation; for the classes with a matrix whose entries are at most `2^16`
-//! in magnitude, the pad's absolute part (at least `2^-102`) covers those errors, so
-//! Outward still contains the exact image of inputs whose values are all normal (tested on
-//! boxes in the lowest normal binades). A translation's face whose sum underflows is
-//! flushed without a trace of its rounding error and can miss by less than `2^-126`.
+//! `2^-126` per operation; the pad's absolute part (at least `2^-102`; a translation's
+//! step from zero is `2^-104`) covers those errors for matrices whose entries are at most
+//! `2^16` in magnitude, so Outward still contains the exact image of inputs whose values
+//! are all normal (tested on boxes in the lowest normal binades).
 //! Under DAZ the CPU reads a subnormal input as zero: the result then bounds the box and
 //! map with those values replaced by zero, which can miss the exact image of the given
 //! values by about `2^-126·(1 + Σ_j |m_ij|)` per axis.

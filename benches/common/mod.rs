@@ -296,3 +296,28 @@ pub fn single_loop<T: bvkit::transform::Transform3>(
         (M::SignSelect, R::Outward) => each!(M::SignSelect, R::Outward),
     }
 }
+
+/// The CPU every figure comes from: the brand string of `/proc/cpuinfo` (Linux), with the
+/// backends bvkit supports on it. Intel and AMD cores differ in what is slow (subnormal
+/// operands cost Intel a microcode assist), so no figure is printed without it.
+pub fn cpu() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, name)| name.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_string());
+    format!("{model} (backends {:?})", bvkit::Backend::supported())
+}
+
+/// Prints the CPU and the backend a bench runs on, before criterion's output.
+pub fn announce(bench: &str) {
+    eprintln!(
+        "{bench}: CPU {}; best backend {:?}",
+        cpu(),
+        bvkit::Backend::detect()
+    );
+}

@@ -43,7 +43,8 @@ fn main() -> std::io::Result<()> {
     // The measuring stages, and one that writes the files.
     let progress = Progress::new(AFFINE3_STAGES + CLASSES3_STAGES + CLASSES2_STAGES + 1);
     eprintln!(
-        "bvkit trade report: best backend {best:?}; {} oracle cases per kernel",
+        "bvkit trade report: CPU {}; best backend {best:?}; {} oracle cases per kernel",
+        common::cpu(),
         measure::cases_per_kernel()
     );
     let mut rows = measure::affine3d(&backends, &progress);

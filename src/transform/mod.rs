@@ -25,7 +25,7 @@
 //!
 //! - affine maps and [`Rigid2`]: `S_i = |t_i| + Σ_j |m_ij|·max(|lo_j|, |hi_j|)`, `τ = 1`;
 //! - translations: `S_i = |t_i| + max(|lo_i|, |hi_i|)`, `τ = 1`, `n = 1` (one rounding);
-//!   Outward steps one ulp, and only on a face whose sum was inexact;
+//!   Outward steps every face one ulp outward (at least `2^-104` from zero);
 //! - quaternion classes: with `ρ = 1 + 2‖q‖²`, which bounds every `|R_ij(q)|` for any
 //!   `q`, `S_i = |t_i| + ρ·Σ_j |s_j|·max(|lo_j|, |hi_j|)` and `τ = 2ρ`; `n` is the
 //!   method's order plus 3 for the rounding of `R(q)` (plus 1 more for the scaled box).
