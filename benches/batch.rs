@@ -23,6 +23,7 @@ fn kernels() -> Vec<(Method, Rounding)> {
 
 fn bench(c: &mut Criterion) {
     announce("batch");
+    let best = Backend::detect();
     for (n, size) in SIZES {
         let (boxes, xfs, poses) = scene(n, 0x5eed);
         let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));

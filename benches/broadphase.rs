@@ -12,9 +12,7 @@ mod common;
 
 use std::hint::black_box;
 
-use bvkit::{
-    Aabb3, Aabb3x8, Active, Backend, Batch, Margin, Method, Moved, Rigid3, Rigid3x8, Rounding,
-};
+use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3, Rigid3x8, Rounding};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3A;
 

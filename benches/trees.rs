@@ -4,7 +4,6 @@
 //! bytes per triangle are printed once before the timings (`examples/trees.rs` prints the
 //! full comparison). `cargo bench --bench trees`.
 
-#[allow(dead_code)]
 mod common;
 #[path = "../tests/trimesh/mod.rs"]
 mod trimesh;

@@ -26,7 +26,7 @@
 //! scaled box for the quaternion classes) is at least `2^-32` (about `2.3·10^-10`) in
 //! magnitude. Real scenes are: a rotation entry of exactly zero is fine, one of `10^-12`
 //! is not. On normal-range input no kernel reads or produces a subnormal number, on any
-//! path (see [`crate::kernel`] for why), so none pays the microcode assist that Intel
+//! path (the proof is beside the pads in `src/kernel.rs`), so none pays the microcode assist that Intel
 //! cores take for one, and the results are bit for bit the same whatever the MXCSR modes
 //! flush-to-zero (FTZ) and denormals-are-zero (DAZ) say: every guarantee holds with
 //! either or both set. The pads' absolute parts are normal constants for this reason.
