@@ -53,7 +53,7 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 ///
 /// Error: `2c` and `2e` round once each, the dot products of `N` terms (onto `2t`) at most
 /// `N + 1` times, the final difference once; halving is exact above the subnormal range
-/// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo|, |hi|)` the face
+/// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo_j|, |hi_j|)` the face
 /// error is at most `γ(N+3)·S + TINY_ERROR`.
 ///
 /// The pad reuses what the method has: `2S' = |2t| + 2^-79 + |M|·(|2c| + 2e)` is `N` more
@@ -232,9 +232,9 @@ impl<V: Axes, const N: usize> MapKernel<V> for AffineLanes<V, N> {
 /// spacing of `f32` at the face, and one step outward is at least that much (at a power of
 /// two the spacing on the far side halves, and so does the largest error there). So the
 /// face contains the exact one, within `u·|face| + 2u·|face| + 2^-103 <= 3u·S + TINY_PAD`.
-/// Two operations a face, where finding the exact rounding error (TwoSum) took seven and
-/// spared the step only on exact sums. Under FTZ a sum that underflows is flushed to
-/// zero, and the step from zero (`2^-104`) still contains it.
+/// The step is taken on exact sums too: three operations a face, against seven to find
+/// the sum's exact error first. Under FTZ a sum that underflows is flushed to zero, and
+/// the step from zero (`2^-104`) still contains it.
 #[inline(always)]
 pub(crate) fn translate<V: Lane>(t: V, lo: V, hi: V, outward: bool) -> (V, V) {
     let (min, max) = (lo + t, hi + t);

@@ -380,30 +380,29 @@ fn outward_under_ftz_and_daz<const N: usize, C: Case<N>>(tiny: bool) {
     }
 }
 
+/// [`outward_under_ftz_and_daz`] for every class.
+#[cfg(target_arch = "x86_64")]
+fn every_class_under_ftz_and_daz(tiny: bool) {
+    outward_under_ftz_and_daz::<3, CaseAffine3>(tiny);
+    outward_under_ftz_and_daz::<3, CaseTranslation3>(tiny);
+    outward_under_ftz_and_daz::<3, CaseRigid3>(tiny);
+    outward_under_ftz_and_daz::<3, CaseSimilarity3>(tiny);
+    outward_under_ftz_and_daz::<3, CaseTrs3>(tiny);
+    outward_under_ftz_and_daz::<2, CaseAffine2>(tiny);
+    outward_under_ftz_and_daz::<2, CaseRigid2>(tiny);
+    outward_under_ftz_and_daz::<2, CaseTranslation2>(tiny);
+}
+
 #[cfg(target_arch = "x86_64")]
 #[test]
 fn outward_contains_under_ftz_and_daz_on_normal_range_input() {
-    outward_under_ftz_and_daz::<3, CaseAffine3>(false);
-    outward_under_ftz_and_daz::<3, CaseTranslation3>(false);
-    outward_under_ftz_and_daz::<3, CaseRigid3>(false);
-    outward_under_ftz_and_daz::<3, CaseSimilarity3>(false);
-    outward_under_ftz_and_daz::<3, CaseTrs3>(false);
-    outward_under_ftz_and_daz::<2, CaseAffine2>(false);
-    outward_under_ftz_and_daz::<2, CaseRigid2>(false);
-    outward_under_ftz_and_daz::<2, CaseTranslation2>(false);
+    every_class_under_ftz_and_daz(false);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[test]
 fn outward_contains_under_ftz_and_daz_on_tiny_normal_input() {
-    outward_under_ftz_and_daz::<3, CaseAffine3>(true);
-    outward_under_ftz_and_daz::<3, CaseTranslation3>(true);
-    outward_under_ftz_and_daz::<2, CaseTranslation2>(true);
-    outward_under_ftz_and_daz::<3, CaseRigid3>(true);
-    outward_under_ftz_and_daz::<3, CaseSimilarity3>(true);
-    outward_under_ftz_and_daz::<3, CaseTrs3>(true);
-    outward_under_ftz_and_daz::<2, CaseAffine2>(true);
-    outward_under_ftz_and_daz::<2, CaseRigid2>(true);
+    every_class_under_ftz_and_daz(true);
 }
 
 #[test]
