@@ -106,6 +106,12 @@ pub(crate) fn inside<const N: usize>(
     (0..N).all(|a| fat_min[a] <= min[a] && max[a] <= fat_max[a])
 }
 
+/// [`inside`] on glam's `Vec3A`: two compares and one mask (false for a NaN face).
+#[inline(always)]
+pub(crate) fn inside_aabb3(tight: &Aabb3, fat: &Aabb3) -> bool {
+    (fat.min.cmple(tight.min) & tight.max.cmple(fat.max)).all()
+}
+
 impl Aabb3 {
     /// The fat box of this tight box: grown by `margin` on every axis and rounded outward,
     /// so that it contains the exact grown box (see [`Batch::update`](crate::Batch::update)).
