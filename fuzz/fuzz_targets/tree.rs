@@ -2,13 +2,14 @@
 //! and two rigid poses from the fuzzer (any quaternion, unit or not), and whenever the exact
 //! boxes overlap under the query's relative map, the conservative test must say so. Then two
 //! two-triangle meshes at those poses: `overlapping_triangles` equals the brute-force exact
-//! pairs, `intersects` agrees, and nothing panics (bad vertices are an error).
+//! pairs, `intersects` agrees, and nothing panics (bad vertices are an error, and so is a
+//! pose that cannot be placed: never a silent "no contact").
 #![no_main]
 
 #[path = "../../tests/sat/mod.rs"]
 mod sat;
 
-use bvkit::tree::{Relative, TriMesh, triangles_intersect};
+use bvkit::tree::{Object, QueryError, Relative, TriMesh, triangles_intersect};
 use bvkit::{Aabb3, Rigid3};
 use bvkit_fuzz::Floats;
 use glam::{Quat, Vec3, Vec3A};
@@ -27,12 +28,19 @@ fuzz_target!(|data: &[u8]| {
     let mut f = Floats::new(data);
     let (pa, pb) = (pose(&mut f), pose(&mut f));
     let (a, b) = (ordered(&mut f), ordered(&mut f));
-    let reach = |x: &Aabb3| x.min.abs().max(x.max.abs()).max_element();
-    let rel = Relative::new(&pa, reach(&a), &pb, reach(&b), 0.0);
-    let ours = rel.overlaps(&a, &b);
+    let reach = |x: &Aabb3| f64::from(x.min.abs().max(x.max.abs()).max_element());
     let finite = [a.min, a.max, b.min, b.max].iter().all(|v| v.is_finite());
-    if rel.is_valid() && finite && sat::exact_overlap(&a, &b, rel.matrix(), rel.translation()) {
-        assert!(ours, "exact boxes overlap, reported separated: {a:?} {b:?} {pa:?} {pb:?}");
+    match Relative::new(&pa, reach(&a), &pb, reach(&b), 0.0) {
+        Ok(rel) => {
+            let ours = rel.overlaps(&a, &b);
+            if finite && sat::exact_overlap(&a, &b, rel.matrix(), rel.translation()) {
+                assert!(ours, "exact boxes overlap, reported separated: {a:?} {b:?} {pa:?} {pb:?}");
+            }
+        }
+        // An error only for a box with an infinite face (its reach) or a pose that cannot
+        // be placed.
+        Err(QueryError::InvalidReach { .. }) => assert!(!finite, "{a:?} {b:?}"),
+        Err(e) => assert!(bad_poses(&pa, &pb, e), "{e}: {pa:?} {pb:?}"),
     }
     let mut mesh = || {
         let v: Vec<Vec3> = (0..4).map(|_| Vec3::from_array(f.array())).collect();
@@ -41,21 +49,44 @@ fuzz_target!(|data: &[u8]| {
     let (Ok(ma), Ok(mb)) = (mesh(), mesh()) else {
         return;
     };
-    let q = ma.query(pa, &mb, pb);
+    let q = match ma.query(pa, &mb, pb) {
+        Ok(q) => q,
+        Err(e) => {
+            assert!(bad_poses(&pa, &pb, e), "{e}: {pa:?} {pb:?}");
+            assert_eq!(ma.intersects(pa, &mb, pb), Err(e));
+            return;
+        }
+    };
     let mut ours = q.overlapping_triangles();
     ours.sort_unstable();
     let mut brute = Vec::new();
-    if q.relative().is_valid() {
-        for i in 0..2 {
-            for j in 0..2 {
-                let ta = ma.triangle(i).unwrap().map(|v| v.as_dvec3());
-                let tb = mb.triangle(j).unwrap().map(|v| q.relative().place(v));
-                if tb.iter().all(|p| p.is_finite()) && triangles_intersect(&ta, &tb) {
-                    brute.push((i, j));
-                }
+    for i in 0..2 {
+        for j in 0..2 {
+            let ta = ma.triangle(i).unwrap().map(|v| v.as_dvec3());
+            let tb = mb.triangle(j).unwrap().map(|v| q.relative().place(v));
+            assert!(tb.iter().all(|p| p.is_finite()), "placed outside f64: {tb:?}");
+            if triangles_intersect(&ta, &tb) {
+                brute.push((i, j));
             }
         }
     }
     assert_eq!(ours, brute, "{ma:?} {mb:?} {pa:?} {pb:?}");
     assert_eq!(q.intersects(), !brute.is_empty());
 });
+
+/// An error is justified: a non-finite pose says which, and out of range needs quaternions
+/// far from unit: with `P = (1 + |qa|²)(1 + |qb|²)`, every entry of `M` is at most `12·P`
+/// and `|t| <= 6·(1 + |qa|²)·2^128`, so the placed bound stays below `2^300` unless
+/// `P > 2^100` (with room to spare).
+fn bad_poses(pa: &Rigid3, pb: &Rigid3, e: QueryError) -> bool {
+    let finite = |p: &Rigid3| p.rotation.is_finite() && p.translation.is_finite();
+    match e {
+        QueryError::NonFinitePose { object: Object::A } => !finite(pa),
+        QueryError::NonFinitePose { object: Object::B } => finite(pa) && !finite(pb),
+        QueryError::OutOfRange => {
+            let n = |p: &Rigid3| 1.0 + f64::from(p.rotation.length_squared());
+            finite(pa) && finite(pb) && n(pa) * n(pb) > 2f64.powi(100)
+        }
+        _ => false,
+    }
+}
