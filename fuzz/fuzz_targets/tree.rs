@@ -9,9 +9,9 @@
 #[path = "../../tests/sat/mod.rs"]
 mod sat;
 
-use bvkit::tree::{Object, QueryError, Relative, TriMesh, triangles_intersect};
+use bvkit::tree::{QueryError, Relative, TriMesh, triangles_intersect};
 use bvkit::{Aabb3, Rigid3};
-use bvkit_fuzz::Floats;
+use bvkit_fuzz::{Floats, query_error_justified};
 use glam::{Quat, Vec3, Vec3A};
 use libfuzzer_sys::fuzz_target;
 
@@ -34,13 +34,16 @@ fuzz_target!(|data: &[u8]| {
         Ok(rel) => {
             let ours = rel.overlaps(&a, &b);
             if finite && sat::exact_overlap(&a, &b, rel.matrix(), rel.translation()) {
-                assert!(ours, "exact boxes overlap, reported separated: {a:?} {b:?} {pa:?} {pb:?}");
+                assert!(
+                    ours,
+                    "exact boxes overlap, reported separated: {a:?} {b:?} {pa:?} {pb:?}"
+                );
             }
         }
         // An error only for a box with an infinite face (its reach) or a pose that cannot
         // be placed.
         Err(QueryError::InvalidReach { .. }) => assert!(!finite, "{a:?} {b:?}"),
-        Err(e) => assert!(bad_poses(&pa, &pb, e), "{e}: {pa:?} {pb:?}"),
+        Err(e) => assert!(justified(&pa, &pb, e), "{e}: {pa:?} {pb:?}"),
     }
     let mut mesh = || {
         let v: Vec<Vec3> = (0..4).map(|_| Vec3::from_array(f.array())).collect();
@@ -52,7 +55,7 @@ fuzz_target!(|data: &[u8]| {
     let q = match ma.query(pa, &mb, pb) {
         Ok(q) => q,
         Err(e) => {
-            assert!(bad_poses(&pa, &pb, e), "{e}: {pa:?} {pb:?}");
+            assert!(justified(&pa, &pb, e), "{e}: {pa:?} {pb:?}");
             assert_eq!(ma.intersects(pa, &mb, pb), Err(e));
             return;
         }
@@ -64,7 +67,10 @@ fuzz_target!(|data: &[u8]| {
         for j in 0..2 {
             let ta = ma.triangle(i).unwrap().map(|v| v.as_dvec3());
             let tb = mb.triangle(j).unwrap().map(|v| q.relative().place(v));
-            assert!(tb.iter().all(|p| p.is_finite()), "placed outside f64: {tb:?}");
+            assert!(
+                tb.iter().all(|p| p.is_finite()),
+                "placed outside f64: {tb:?}"
+            );
             if triangles_intersect(&ta, &tb) {
                 brute.push((i, j));
             }
@@ -74,19 +80,6 @@ fuzz_target!(|data: &[u8]| {
     assert_eq!(q.intersects(), !brute.is_empty());
 });
 
-/// An error is justified: a non-finite pose says which, and out of range needs quaternions
-/// far from unit: with `P = (1 + |qa|²)(1 + |qb|²)`, every entry of `M` is at most `12·P`
-/// and `|t| <= 6·(1 + |qa|²)·2^128`, so the placed bound stays below `2^300` unless
-/// `P > 2^100` (with room to spare).
-fn bad_poses(pa: &Rigid3, pb: &Rigid3, e: QueryError) -> bool {
-    let finite = |p: &Rigid3| p.rotation.is_finite() && p.translation.is_finite();
-    match e {
-        QueryError::NonFinitePose { object: Object::A } => !finite(pa),
-        QueryError::NonFinitePose { object: Object::B } => finite(pa) && !finite(pb),
-        QueryError::OutOfRange => {
-            let n = |p: &Rigid3| 1.0 + f64::from(p.rotation.length_squared());
-            finite(pa) && finite(pb) && n(pa) * n(pb) > 2f64.powi(100)
-        }
-        _ => false,
-    }
+fn justified(pa: &Rigid3, pb: &Rigid3, e: QueryError) -> bool {
+    query_error_justified(&(*pa).into(), &(*pb).into(), 0.0, e)
 }
