@@ -69,11 +69,13 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
     for &p in &poses {
         first += a
             .query(id, &b, p)
+            .unwrap()
             .visit(|_, _| ControlFlow::Break(()))
             .1
             .node_pairs;
         all += a
             .query(id, &b, p)
+            .unwrap()
             .visit(|_, _| ControlFlow::Continue(()))
             .1
             .node_pairs;
@@ -95,7 +97,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
         it.iter(|| {
             poses
                 .iter()
-                .filter(|&&p| a.intersects(id, black_box(&b), p))
+                .filter(|&&p| a.intersects(id, black_box(&b), p).unwrap())
                 .count()
         })
     });
@@ -103,7 +105,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
         it.iter(|| {
             poses
                 .iter()
-                .filter(|&&p| aq.intersects(id, black_box(&bq), p))
+                .filter(|&&p| aq.intersects(id, black_box(&bq), p).unwrap())
                 .count()
         })
     });
@@ -114,7 +116,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
         it.iter(|| {
             poses
                 .iter()
-                .map(|&p| a.overlapping_triangles(id, black_box(&b), p).len())
+                .map(|&p| a.overlapping_triangles(id, black_box(&b), p).unwrap().len())
                 .sum::<usize>()
         })
     });
@@ -122,7 +124,11 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
         it.iter(|| {
             poses
                 .iter()
-                .map(|&p| aq.overlapping_triangles(id, black_box(&bq), p).len())
+                .map(|&p| {
+                    aq.overlapping_triangles(id, black_box(&bq), p)
+                        .unwrap()
+                        .len()
+                })
                 .sum::<usize>()
         })
     });

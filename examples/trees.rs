@@ -82,7 +82,11 @@ fn main() {
         let per = |d: Duration| d.as_secs_f64() * 1e6 / n;
 
         // First contact.
-        let hits = s.poses.iter().filter(|&&p| a.intersects(id, &b, p)).count();
+        let hits = s
+            .poses
+            .iter()
+            .filter(|&&p| a.intersects(id, &b, p).expect("finite pose"))
+            .count();
         let parry_hits = s
             .poses
             .iter()
@@ -92,11 +96,16 @@ fn main() {
                     .unwrap_or(false)
             })
             .count();
-        let ours = time(|| s.poses.iter().filter(|&&p| a.intersects(id, &b, p)).count());
+        let ours = time(|| {
+            s.poses
+                .iter()
+                .filter(|&&p| a.intersects(id, &b, p).expect("finite pose"))
+                .count()
+        });
         let ours_q = time(|| {
             s.poses
                 .iter()
-                .filter(|&&p| aq.intersects(id, &bq, p))
+                .filter(|&&p| aq.intersects(id, &bq, p).expect("finite pose"))
                 .count()
         });
         let theirs = time(|| {
@@ -114,6 +123,7 @@ fn main() {
             .iter()
             .map(|&p| {
                 a.query(id, &b, p)
+                    .expect("finite pose")
                     .visit(|_, _| ControlFlow::Break(()))
                     .1
                     .node_pairs
@@ -134,7 +144,11 @@ fn main() {
         let pairs: usize = s
             .poses
             .iter()
-            .map(|&p| a.overlapping_triangles(id, &b, p).len())
+            .map(|&p| {
+                a.overlapping_triangles(id, &b, p)
+                    .expect("finite pose")
+                    .len()
+            })
             .sum();
         let parry_checks = Cell::new(0u64);
         let parry_all = |count: bool| -> usize {
@@ -164,13 +178,21 @@ fn main() {
         let ours = time(|| {
             s.poses
                 .iter()
-                .map(|&p| a.overlapping_triangles(id, &b, p).len())
+                .map(|&p| {
+                    a.overlapping_triangles(id, &b, p)
+                        .expect("finite pose")
+                        .len()
+                })
                 .sum::<usize>()
         });
         let ours_q = time(|| {
             s.poses
                 .iter()
-                .map(|&p| aq.overlapping_triangles(id, &bq, p).len())
+                .map(|&p| {
+                    aq.overlapping_triangles(id, &bq, p)
+                        .expect("finite pose")
+                        .len()
+                })
                 .sum::<usize>()
         });
         let ours_x = time(|| {
@@ -178,6 +200,7 @@ fn main() {
                 .iter()
                 .map(|&p| {
                     a.query(id, &b, p)
+                        .expect("finite pose")
                         .with_cross_axes_near_leaves(true)
                         .overlapping_triangles()
                         .len()
@@ -189,7 +212,11 @@ fn main() {
             .poses
             .iter()
             .map(|&p| {
-                let st = a.query(id, &b, p).visit(|_, _| ControlFlow::Continue(())).1;
+                let st = a
+                    .query(id, &b, p)
+                    .expect("finite pose")
+                    .visit(|_, _| ControlFlow::Continue(()))
+                    .1;
                 (st.node_pairs, st.leaf_pairs)
             })
             .fold((0, 0), |(x, y), (u, v)| (x + u, y + v));
@@ -198,6 +225,7 @@ fn main() {
             .iter()
             .map(|&p| {
                 a.query(id, &b, p)
+                    .expect("finite pose")
                     .with_cross_axes_near_leaves(true)
                     .visit(|_, _| ControlFlow::Continue(()))
                     .1

@@ -428,15 +428,17 @@ fn tree_queries_raise_no_subnormal_flag() {
     let ((), flags) = mxcsr::run(0, (), |()| {
         for (k, (&pa, &pb)) in poses_a.iter().zip(&poses_b).enumerate() {
             let pb = if k % 4 == 0 { Rigid3::IDENTITY } else { pb };
-            let q = Query::new(&a, pa, &b, pb).with_tolerance(if k % 2 == 0 { 0.0 } else { 0.01 });
+            let q = Query::new(&a, pa, &b, pb)
+                .and_then(|q| q.with_tolerance(if k % 2 == 0 { 0.0 } else { 0.01 }))
+                .unwrap();
             core::hint::black_box(q.intersects());
             core::hint::black_box(q.overlapping_triangles());
-            let q = Query::new(&aq, pa, &bq, pb);
+            let q = Query::new(&aq, pa, &bq, pb).unwrap();
             core::hint::black_box(q.overlapping_triangles());
             let (sa, sb) = (Similarity3::from(pa), Similarity3::from(pb));
-            let q = Query::similarity(&a, sa, &b, Similarity3 { scale: 1.5, ..sb });
+            let q = Query::similarity(&a, sa, &b, Similarity3 { scale: 1.5, ..sb }).unwrap();
             core::hint::black_box(q.overlapping_triangles());
-            let q = Query::new(&tree, pa, &tree, pb);
+            let q = Query::new(&tree, pa, &tree, pb).unwrap();
             core::hint::black_box(q.leaf_pairs());
         }
     });

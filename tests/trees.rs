@@ -11,19 +11,19 @@ mod trimesh;
 use std::ops::ControlFlow;
 
 use bvkit::tree::{
-    AabbTree, Compact, MeshError, Quantized, Query, Relative, TriMesh, triangles_distance_sq,
-    triangles_intersect,
+    AabbTree, Compact, MeshError, Object, Quantized, Query, QueryError, Relative, TriMesh,
+    triangles_distance_sq, triangles_intersect,
 };
 use bvkit::{Aabb3, Rigid3, Similarity3};
 use glam::{DVec3, Quat, Vec3, Vec3A};
 use sat::{exact_overlap, exact_triangles};
 use trimesh::Uniform;
 
-fn reach(boxes: &[Aabb3]) -> f32 {
+fn reach(boxes: &[Aabb3]) -> f64 {
     boxes
         .iter()
-        .map(|b| b.min.abs().max(b.max.abs()).max_element())
-        .fold(0.0, f32::max)
+        .map(|b| f64::from(b.min.abs().max(b.max.abs()).max_element()))
+        .fold(0.0, f64::max)
 }
 
 fn aabb(c: Vec3, h: Vec3) -> Aabb3 {
@@ -36,7 +36,7 @@ type Case = (Aabb3, Aabb3, Rigid3, Rigid3);
 /// A box `b` and a pose, then `a` placed to just touch (or just miss) `b`'s exact image on
 /// one axis of A: its face is the f64 extreme of the image, rounded to f32 either way.
 fn near_contact(g: &mut Uniform, b: Aabb3, pa: Rigid3, pb: Rigid3, size: f32) -> Aabb3 {
-    let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0);
+    let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0).unwrap();
     let corners: Vec<DVec3> = (0..8)
         .map(|k| {
             let p = Vec3::new(
@@ -164,8 +164,7 @@ fn box_pair_test_never_separates_overlapping_boxes() {
     let mut separated_found = 0;
     let mut separated_total = 0;
     for (class, (a, b, pa, pb)) in adversarial_cases() {
-        let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
-        assert!(rel.is_valid());
+        let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0).unwrap();
         let exact = exact_overlap(&a, &b, rel.matrix(), rel.translation());
         let ours = rel.overlaps(&a, &b);
         assert!(
@@ -214,9 +213,9 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
             AabbTree::<Quantized>::build(&ba).unwrap(),
             AabbTree::<Quantized>::build(&bb).unwrap(),
         );
-        let pairs = ta.query(pa, &tb, pb).leaf_pairs();
-        let qpairs = qa.query(pa, &qb, pb).leaf_pairs();
-        let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0);
+        let pairs = ta.query(pa, &tb, pb).unwrap().leaf_pairs();
+        let qpairs = qa.query(pa, &qb, pb).unwrap().leaf_pairs();
+        let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0).unwrap();
         let mut exact_count = 0;
         for (i, a) in ba.iter().enumerate() {
             for (j, b) in bb.iter().enumerate() {
@@ -235,7 +234,7 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
         sorted.sort_unstable();
         sorted.dedup();
         assert_eq!(sorted.len(), pairs.len());
-        let rel = ta.query(pa, &tb, pb).relative().to_owned();
+        let rel = ta.query(pa, &tb, pb).unwrap().relative().to_owned();
         for &(i, j) in &pairs {
             assert!(rel.overlaps(&ba[i as usize], &bb[j as usize]));
         }
@@ -420,7 +419,10 @@ fn overlapping_triangles_equal_brute_force() {
                     pb
                 };
                 let tolerance = if k % 3 == 2 { 0.05 } else { 0.0 };
-                let q = Query::new(&a, pa, &b, pb).with_tolerance(tolerance);
+                let q = Query::new(&a, pa, &b, pb)
+                    .unwrap()
+                    .with_tolerance(tolerance)
+                    .unwrap();
                 let mut ours = q.overlapping_triangles();
                 ours.sort_unstable();
                 let expected = brute_force(&a, &b, q.relative(), tolerance);
@@ -431,7 +433,8 @@ fn overlapping_triangles_equal_brute_force() {
                     "{na} vs {nb}, pose {k}"
                 );
                 let mut quant = Query::new(&aq, pa, &bq, pb)
-                    .with_tolerance(tolerance)
+                    .and_then(|q| q.with_tolerance(tolerance))
+                    .unwrap()
                     .overlapping_triangles();
                 quant.sort_unstable();
                 assert_eq!(quant, expected, "quantized {na} vs {nb}, pose {k}");
@@ -450,11 +453,13 @@ fn overlapping_triangles_equal_brute_force() {
 fn visitor_stops_early() {
     let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
     let a = TriMesh::new(v, t).unwrap();
-    let q = a.query(
-        Rigid3::IDENTITY,
-        &a,
-        Rigid3::new(Quat::from_rotation_x(0.3), Vec3A::ZERO),
-    );
+    let q = a
+        .query(
+            Rigid3::IDENTITY,
+            &a,
+            Rigid3::new(Quat::from_rotation_x(0.3), Vec3A::ZERO),
+        )
+        .unwrap();
     let all = q.overlapping_triangles();
     assert!(all.len() > 3);
     let mut seen = 0;
@@ -487,9 +492,11 @@ fn layouts_fit_their_budgets() {
     let pose = trimesh::poses(1, 0.5, 9)[0];
     assert_eq!(
         a.query(Rigid3::IDENTITY, &a, pose)
+            .unwrap()
             .visit_boxes(|_, _| ControlFlow::Continue(()))
             .1,
         b.query(Rigid3::IDENTITY, &b, pose)
+            .unwrap()
             .visit_boxes(|_, _| ControlFlow::Continue(()))
             .1
     );
@@ -522,34 +529,160 @@ fn bad_input_is_an_error() {
     assert!(AabbTree::new(&[]).is_err());
     assert!(AabbTree::new(&[Aabb3::new(Vec3A::ONE, Vec3A::ZERO)]).is_err());
     assert!(AabbTree::new(&[Aabb3::new(Vec3A::ZERO, Vec3A::INFINITY)]).is_err());
-    // Non-finite poses and tolerances: no panic, nothing reported.
-    let nan = Rigid3::new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3A::ZERO);
-    assert!(!mesh.intersects(nan, &mesh, Rigid3::IDENTITY));
-    assert!(
-        mesh.query(Rigid3::IDENTITY, &mesh, Rigid3::IDENTITY)
-            .with_tolerance(f32::NAN)
-            .overlapping_triangles()
-            .is_empty()
-    );
     // One triangle against itself: touching everywhere.
     assert_eq!(
         mesh.overlapping_triangles(Rigid3::IDENTITY, &mesh, Rigid3::IDENTITY),
-        vec![(0, 0)]
+        Ok(vec![(0, 0)])
     );
-    // Extreme but finite geometry builds and queries without panicking.
+}
+
+/// A mesh whose vertices reach `±f32::MAX` is accepted by `TriMesh::new`, so it must be
+/// queried like any other: a triangle against itself touches.
+fn huge_mesh() -> TriMesh {
     let huge = vec![
         Vec3::splat(-f32::MAX),
         Vec3::splat(f32::MAX),
         Vec3::new(f32::MAX, 0.0, -f32::MAX),
+        Vec3::new(0.0, f32::MAX, f32::MAX),
     ];
-    let h = TriMesh::new(huge, vec![[0, 1, 2], [2, 1, 0]]).unwrap();
+    TriMesh::new(huge, vec![[0, 1, 2], [2, 1, 0], [1, 3, 0]]).unwrap()
+}
+
+#[test]
+fn geometry_reaching_f32_max_reports_contact() {
+    let h = huge_mesh();
     let hq = h.with_layout::<Quantized>();
-    assert_eq!(h.triangle(2), None);
-    let _ = h.overlapping_triangles(
-        Rigid3::IDENTITY,
-        &hq,
-        Rigid3::new(Quat::from_rotation_y(1.0), Vec3A::splat(1e38)),
+    assert!(h.reach().is_finite() && hq.reach().is_finite());
+    assert!(h.reach() >= f64::from(f32::MAX));
+    assert_eq!(h.triangle(3), None);
+    let id = Rigid3::IDENTITY;
+    let turned = Rigid3::new(Quat::from_rotation_y(1.0), Vec3A::splat(1e38));
+    for (pb, name) in [(id, "identity"), (turned, "turned")] {
+        let q = Query::new(&h, id, &hq, pb).unwrap();
+        let mut ours = q.overlapping_triangles();
+        ours.sort_unstable();
+        let expected = brute_force(&h, &hq, q.relative(), 0.0);
+        assert!(!expected.is_empty(), "{name}");
+        assert_eq!(ours, expected, "{name}");
+        assert_eq!(h.intersects(id, &hq, pb), Ok(true), "{name}");
+        assert_eq!(hq.intersects(id, &h, pb), Ok(true), "{name}");
+    }
+    // Each triangle meets itself, in both layouts.
+    for (i, j) in [(0, 0), (1, 1), (2, 2)] {
+        assert!(
+            h.overlapping_triangles(id, &h, id)
+                .unwrap()
+                .contains(&(i, j))
+        );
+        assert!(
+            hq.overlapping_triangles(id, &hq, id)
+                .unwrap()
+                .contains(&(i, j))
+        );
+    }
+    // Bare boxes: a box reaching ±f32::MAX overlaps itself and a small box inside it.
+    let boxes = [
+        Aabb3::new(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX)),
+        Aabb3::new(Vec3A::ZERO, Vec3A::new(f32::MAX, 1.0, f32::MAX)),
+        Aabb3::new(Vec3A::ONE, Vec3A::splat(2.0)),
+    ];
+    let t = AabbTree::new(&boxes).unwrap();
+    let tq = AabbTree::<Quantized>::build(&boxes).unwrap();
+    assert!(t.reach().is_finite() && tq.reach().is_finite());
+    for pairs in [
+        t.query(id, &t, id).unwrap().leaf_pairs(),
+        tq.query(id, &tq, id).unwrap().leaf_pairs(),
+        t.query(id, &tq, turned).unwrap().leaf_pairs(),
+    ] {
+        for p in [(0, 0), (0, 2), (2, 0), (1, 1)] {
+            assert!(pairs.contains(&p), "{p:?} missing from {pairs:?}");
+        }
+    }
+}
+
+#[test]
+fn queries_that_cannot_decide_are_errors() {
+    let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
+    let a = TriMesh::new(v, t).unwrap();
+    let aq = a.with_layout::<Quantized>();
+    let id = Rigid3::IDENTITY;
+    // The same poses with valid components overlap: the errors below are not misses.
+    assert_eq!(a.intersects(id, &a, id), Ok(true));
+    let nan_q = Rigid3::new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3A::ZERO);
+    let inf_t = Rigid3::new(Quat::IDENTITY, Vec3A::new(0.0, f32::INFINITY, 0.0));
+    let pose_b = QueryError::NonFinitePose { object: Object::B };
+    let pose_a = QueryError::NonFinitePose { object: Object::A };
+    assert_eq!(a.intersects(id, &a, nan_q), Err(pose_b));
+    assert_eq!(a.intersects(inf_t, &aq, id), Err(pose_a));
+    assert_eq!(a.overlapping_triangles(id, &a, inf_t), Err(pose_b));
+    // Tolerances: NaN, negative and infinite are errors; zero and positive are not.
+    for tolerance in [f32::NAN, -0.5, f32::INFINITY, f32::NEG_INFINITY] {
+        let r = a.query(id, &a, id).unwrap().with_tolerance(tolerance);
+        assert!(
+            matches!(r, Err(QueryError::InvalidTolerance { .. })),
+            "{tolerance}"
+        );
+    }
+    assert!(a.query(id, &a, id).unwrap().with_tolerance(0.0).is_ok());
+    assert!(a.query(id, &a, id).unwrap().with_tolerance(0.1).is_ok());
+    // Similarity poses: a zero scale and a NaN scale; a negative one reflects and is fine.
+    let s = |scale: f32| Similarity3::new(scale, Quat::IDENTITY, Vec3A::ZERO);
+    let zero = Query::similarity(&a, s(0.0), &aq, Similarity3::IDENTITY);
+    assert!(matches!(
+        zero,
+        Err(QueryError::ZeroScale { object: Object::A })
+    ));
+    let nan = Query::similarity(&a, Similarity3::IDENTITY, &aq, s(f32::NAN));
+    assert!(matches!(
+        nan,
+        Err(QueryError::NonFinitePose { object: Object::B })
+    ));
+    assert!(
+        Query::similarity(&a, s(-1.0), &aq, s(-1.0))
+            .unwrap()
+            .intersects()
     );
+    // A relative map out of range: huge non-unit quaternions on both poses (|M| near 2^400,
+    // and near 2^510 with N·M overflowing f64), and a scale ratio of 2^276 on a huge mesh. One such
+    // quaternion alone stays in range, and the exact leaf test decides it.
+    let big = Rigid3::new(Quat::from_xyzw(1e30, 0.0, 0.0, 0.0), Vec3A::ZERO);
+    assert_eq!(a.intersects(id, &a, big), Ok(true));
+    for q in [
+        Quat::from_xyzw(1e30, 0.0, 0.0, 0.0),
+        Quat::from_array([f32::MAX; 4]),
+    ] {
+        let p = Rigid3::new(q, Vec3A::ZERO);
+        assert_eq!(a.intersects(p, &a, p), Err(QueryError::OutOfRange), "{q:?}");
+    }
+    // The largest scale ratio (2^276) on a small mesh is in range; on a mesh reaching
+    // f32::MAX it places B near 2^404.
+    assert!(Query::similarity(&a, s(1e-45), &aq, s(f32::MAX)).is_ok());
+    let h = huge_mesh();
+    let ratio = Query::similarity(&a, s(1e-45), &h, s(f32::MAX));
+    assert!(matches!(ratio, Err(QueryError::OutOfRange)));
+    // Bare trees: the same errors.
+    let boxes = [Aabb3::new(Vec3A::ZERO, Vec3A::ONE)];
+    let tree = AabbTree::new(&boxes).unwrap();
+    assert!(matches!(
+        tree.query(id, &tree, nan_q),
+        Err(QueryError::NonFinitePose { .. })
+    ));
+    assert_eq!(
+        tree.query(id, &tree, id).unwrap().leaf_pairs(),
+        vec![(0, 0)]
+    );
+    // The box-pair test on its own: bad reaches and tolerances.
+    for (reach, tolerance) in [
+        (f64::NAN, 0.0),
+        (-1.0, 0.0),
+        (f64::INFINITY, 0.0),
+        (1.0, -1.0),
+    ] {
+        assert!(Relative::new(&id, reach, &id, 1.0, tolerance).is_err());
+    }
+    // Each error says what was wrong.
+    let text = QueryError::ZeroScale { object: Object::A }.to_string();
+    assert!(text.contains("zero scale"), "{text}");
 }
 
 #[test]
@@ -566,9 +699,15 @@ fn refit_matches_a_fresh_build() {
     let fresh = TriMesh::new(moved, t.clone()).unwrap();
     let other = TriMesh::new(v, t).unwrap();
     for pose in trimesh::poses(8, 0.7, 5) {
-        let mut x = a.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
-        let mut y = fresh.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
-        let mut z = aq.overlapping_triangles(Rigid3::IDENTITY, &other, pose);
+        let mut x = a
+            .overlapping_triangles(Rigid3::IDENTITY, &other, pose)
+            .unwrap();
+        let mut y = fresh
+            .overlapping_triangles(Rigid3::IDENTITY, &other, pose)
+            .unwrap();
+        let mut z = aq
+            .overlapping_triangles(Rigid3::IDENTITY, &other, pose)
+            .unwrap();
         x.sort_unstable();
         y.sort_unstable();
         z.sort_unstable();
@@ -588,7 +727,7 @@ fn similarity_poses() {
         let (sa, sb) = if g.next() < 0.2 { (-sa, sb) } else { (sa, sb) };
         let pa = Similarity3::new(sa, pa.rotation, pa.translation);
         let pb = Similarity3::new(sb, pb.rotation, pb.translation);
-        let rel = Relative::similarity(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+        let rel = Relative::similarity(&pa, reach(&[a]), &pb, reach(&[b]), 0.0).unwrap();
         let exact = exact_overlap(&a, &b, rel.matrix(), rel.translation());
         assert!(
             rel.overlaps(&a, &b) || !exact,
@@ -606,7 +745,7 @@ fn similarity_poses() {
         let s = 0.5 + 0.2 * k as f32;
         let pa = Similarity3::new(1.5, Quat::IDENTITY, Vec3A::ZERO);
         let pb = Similarity3::new(s, p.rotation, p.translation);
-        let q = Query::similarity(&a, pa, &b, pb);
+        let q = Query::similarity(&a, pa, &b, pb).unwrap();
         let mut ours = q.overlapping_triangles();
         ours.sort_unstable();
         let expected = brute_force(&a, &b, q.relative(), 0.0);
@@ -614,13 +753,6 @@ fn similarity_poses() {
         total += expected.len();
     }
     assert!(total > 20, "{total}");
-    // A zero scale places nothing and does not panic.
-    let zero = Similarity3::new(0.0, Quat::IDENTITY, Vec3A::ZERO);
-    assert!(
-        Query::similarity(&a, zero, &b, Similarity3::IDENTITY)
-            .overlapping_triangles()
-            .is_empty()
-    );
 }
 
 #[test]
@@ -640,7 +772,7 @@ fn sums_that_would_overflow_f32_never_separate() {
         Quat::from_xyzw(0.0, 1.001_403_8, 0.0, 0.0),
         Vec3A::new(1e30, f32::MAX, f32::MAX),
     );
-    let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0);
+    let rel = Relative::new(&pa, reach(&[a]), &pb, reach(&[b]), 0.0).unwrap();
     assert!(exact_overlap(&a, &b, rel.matrix(), rel.translation()));
     assert!(rel.overlaps(&a, &b));
     assert_eq!(rel.pad(), f32::INFINITY);
@@ -670,11 +802,12 @@ fn adversarial_builds_find_every_overlap() {
             let c0 = boxes[0].center();
             // B is A turned about A's first box (so that the far boxes still meet).
             let pose = Rigid3::new(pose.rotation, c0 - pose.rotation * c0);
-            let q = compact.query(Rigid3::IDENTITY, &compact, pose);
+            let q = compact.query(Rigid3::IDENTITY, &compact, pose).unwrap();
             let (pairs, qpairs) = (
                 q.leaf_pairs(),
                 quantized
                     .query(Rigid3::IDENTITY, &quantized, pose)
+                    .unwrap()
                     .leaf_pairs(),
             );
             let rel = q.relative();

@@ -4,7 +4,9 @@
 #[path = "../../tests/oracle/mod.rs"]
 pub mod oracle;
 
-use bvkit::{Aabb2, Method, Rigid2, Rounding};
+use bvkit::tree::{Object, QueryError};
+use bvkit::{Aabb2, Method, Rigid2, Rounding, Similarity3};
+use glam::{Quat, Vec3A};
 use oracle::{Bound, Exactly, Problem, QuatProblem};
 
 pub use oracle::{affine2, affine3};
@@ -144,4 +146,47 @@ pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
 /// The bound of a class of order `n` (its `nearest_gamma(method)`).
 pub fn bound_of(n: u32, rounding: Rounding) -> Bound {
     Bound::of_order(n, rounding)
+}
+
+/// True when a tree query's error is justified by its input, checked in the order the query
+/// checks it: `A`'s pose (non-finite, then zero scale), `B`'s, the tolerance, then the
+/// range. Out of range needs a map far from the unit scale: with `P = (1 + |qa|²)(1 + |qb|²)`,
+/// `r` the larger scale ratio and `i = max(1, 1/|σa|)`, every entry of `M` and `N` is at
+/// most `12·P·r` and `|t| <= 6·(1 + |qa|²)·i·2^129`; when `P·r·i·(1 + |qa|²) <= 2^100`
+/// everything the query checks stays far below `2^300` (trees reach at most `2^129`).
+pub fn query_error_justified(
+    pa: &Similarity3,
+    pb: &Similarity3,
+    tolerance: f32,
+    e: QueryError,
+) -> bool {
+    let finite = |p: &Similarity3| {
+        p.rotation.is_finite() && p.translation.is_finite() && p.scale.is_finite()
+    };
+    let ok = |p: &Similarity3| finite(p) && p.scale != 0.0;
+    let tolerance_ok = tolerance.is_finite() && tolerance >= 0.0;
+    let far = || {
+        let n = |p: &Similarity3| 1.0 + f64::from(p.rotation.length_squared());
+        let (sa, sb) = (f64::from(pa.scale).abs(), f64::from(pb.scale).abs());
+        let ratio = (sa / sb).max(sb / sa);
+        n(pa) * n(pb) * ratio * (1.0 / sa).max(1.0) * n(pa) > 2f64.powi(100)
+    };
+    match e {
+        QueryError::NonFinitePose { object: Object::A } => !finite(pa),
+        QueryError::ZeroScale { object: Object::A } => finite(pa) && pa.scale == 0.0,
+        QueryError::NonFinitePose { object: Object::B } => ok(pa) && !finite(pb),
+        QueryError::ZeroScale { object: Object::B } => ok(pa) && finite(pb) && pb.scale == 0.0,
+        QueryError::InvalidTolerance { .. } => ok(pa) && ok(pb) && !tolerance_ok,
+        QueryError::OutOfRange => ok(pa) && ok(pb) && tolerance_ok && far(),
+        QueryError::InvalidReach { .. } => false,
+    }
+}
+
+/// A similarity pose from the fuzzer: any quaternion and translation, and (when `scaled`)
+/// any scale, else 1.
+pub fn similarity(f: &mut Floats, scaled: bool) -> Similarity3 {
+    let rotation = Quat::from_array(f.array());
+    let translation = Vec3A::from_array(f.array());
+    let scale = if scaled { f.next() } else { 1.0 };
+    Similarity3::new(scale, rotation, translation)
 }

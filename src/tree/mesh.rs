@@ -86,8 +86,9 @@ impl core::error::Error for MeshError {}
 pub(crate) struct Hierarchy<L> {
     pub layout: L,
     pub root: Ref,
-    /// Every box of the tree (nodes and primitives) lies within `±reach` on every axis.
-    pub reach: f32,
+    /// Every box of the tree (nodes as stored and primitives) lies within `±reach` on every
+    /// axis, to within `2^-52` relative ([`Hierarchy::measure`]).
+    pub reach: f64,
 }
 
 impl<L: Layout> Hierarchy<L> {
@@ -114,8 +115,11 @@ impl<L: Layout> Hierarchy<L> {
         self.reach = self.measure(boxes);
     }
 
-    /// The largest `|coordinate|` of any box as read back, rounded up.
-    fn measure(&self, boxes: &[PrimBox]) -> f32 {
+    /// The largest `|coordinate|` of any box (primitive, or node as stored), in `f64`: finite
+    /// for every finite tree (nodes reaching `±f32::MAX` included, whose `f32` read-back may
+    /// overflow), within two `f64` roundings (`2^-52` relative) of the exact value, which the
+    /// pad's factor `1 + 2^-18` on the reach absorbs ([`super::Relative`]).
+    fn measure(&self, boxes: &[PrimBox]) -> f64 {
         let mut reach = 0.0f64;
         for b in boxes {
             for k in 0..3 {
@@ -123,12 +127,10 @@ impl<L: Layout> Hierarchy<L> {
             }
         }
         for i in 0..self.layout.len() {
-            let (c, e) = self.layout.node_box(i as u32);
-            let r = c.abs().as_dvec3() + e.as_dvec3();
-            reach = reach.max(r.max_element());
+            let (c, e) = self.layout.node_box_f64(i as u32);
+            reach = reach.max((c.abs() + e).max_element());
         }
-        let r = reach as f32;
-        if f64::from(r) < reach { r.next_up() } else { r }
+        reach
     }
 
     /// The tree's bytes: the nodes, child references included.
@@ -306,9 +308,10 @@ impl<L: Layout> TriMesh<L> {
         self.tree.node_bytes()
     }
 
-    /// Every box of the tree lies within `±reach()` on every axis.
+    /// Every box of the tree lies within `±reach()` on every axis (in `f64`, so finite for
+    /// every finite tree; within `2^-52` relative of the exact bound).
     #[must_use]
-    pub fn reach(&self) -> f32 {
+    pub fn reach(&self) -> f64 {
         self.tree.reach
     }
 
@@ -388,9 +391,10 @@ impl<L: Layout> AabbTree<L> {
         self.tree.node_bytes()
     }
 
-    /// Every box of the tree lies within `±reach()` on every axis.
+    /// Every box of the tree lies within `±reach()` on every axis (in `f64`, so finite for
+    /// every finite tree; within `2^-52` relative of the exact bound).
     #[must_use]
-    pub fn reach(&self) -> f32 {
+    pub fn reach(&self) -> f64 {
         self.tree.reach
     }
 }

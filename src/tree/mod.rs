@@ -18,16 +18,23 @@
 //! };
 //! let (a, b) = (tetra(1.0)?, tetra(1.0)?);
 //! let pb = Rigid3::new(Quat::from_rotation_z(0.5), Vec3A::new(0.25, 0.25, 0.25));
-//! assert!(a.intersects(Rigid3::IDENTITY, &b, pb));
+//! assert!(a.intersects(Rigid3::IDENTITY, &b, pb)?);
 //! let far = Rigid3::new(Quat::IDENTITY, Vec3A::X * 3.0);
-//! assert!(!a.intersects(Rigid3::IDENTITY, &b, far));
-//! # Ok::<(), bvkit::tree::MeshError>(())
+//! assert!(!a.intersects(Rigid3::IDENTITY, &b, far)?);
+//! // A pose that places nothing is an error, never "no contact".
+//! let nan = Rigid3::new(Quat::IDENTITY, Vec3A::splat(f32::NAN));
+//! assert!(a.intersects(Rigid3::IDENTITY, &b, nan).is_err());
+//! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
 //!
 //! **Guarantees.** Box culling is conservative by proof (the pad's derivation is in
 //! [`Relative`]); the leaf triangle test is exact ([`triangles_intersect`]), so
 //! [`Query::intersects`] and [`Query::overlapping_triangles`] are exact for the geometry
-//! [`Relative`] defines. Bad input is a [`MeshError`]; nothing panics.
+//! [`Relative`] defines. A bad mesh is a [`MeshError`], a bad pose or tolerance a
+//! [`QueryError`]; nothing panics, and no query answers "no contact" for input it cannot
+//! decide. Meshes are accepted for every finite vertex, `±f32::MAX` included: the reach is
+//! kept in `f64`, and past `2^126` the pad is infinite (nothing is culled, the exact leaf
+//! test decides).
 
 mod build;
 mod mesh;
@@ -39,5 +46,5 @@ mod triangle;
 pub use mesh::{AabbTree, MeshError, TriMesh};
 pub use nodes::{Compact, Layout, Quantized};
 pub use query::{Query, Shape, Stats};
-pub use relative::Relative;
+pub use relative::{Object, QueryError, Relative};
 pub use triangle::{triangles_distance_sq, triangles_intersect};

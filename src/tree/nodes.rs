@@ -13,9 +13,10 @@
 //! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
 //! coordinate (`origin + step·c`); the query pad covers that rounding.
 
+use crate::extended::{round_up, two_sum};
 use crate::math::{ceil, pow2, pow2_at_least, round};
 use alloc::vec::Vec;
-use glam::Vec3A;
+use glam::{DVec3, Vec3A};
 
 /// A child: a node index, or a primitive id with the top bit set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,26 +60,34 @@ pub(crate) struct QNode {
     pub children: [Ref; 2],
 }
 
-/// The smallest `f32` at least `x` (for `x >= 0`; `+inf` past the range).
-fn round_up(x: f64) -> f32 {
-    let y = x as f32;
-    if f64::from(y) < x { y.next_up() } else { y }
+/// The smallest `f32` at least the exact distance `hi − lo` (`lo <= hi`, both finite).
+///
+/// TwoSum in `f64` gives the distance exactly as `d + err` (a difference of two `f32` values
+/// cannot overflow `f64`). `round_up(d)` covers it unless it equals `d` and `err > 0`, when
+/// the next `f32` does: an `f32` above `d` is at least one `f64` spacing above it, and
+/// `|err|` is at most half of one.
+fn distance_up(lo: f32, hi: f32) -> f32 {
+    let (d, err) = two_sum(f64::from(hi), -f64::from(lo));
+    let up = round_up(d);
+    if f64::from(up) == d && err > 0.0 {
+        up.next_up()
+    } else {
+        up
+    }
 }
 
 /// `center ± extent` containing `[min, max]` exactly: the center is `min/2 + max/2` in
-/// `f32`, and the extent is the larger distance to a face, computed in `f64` (within
-/// `2^-53` relative) and rounded up to `f32`, then raised by one more ulp, which absorbs the
-/// `f64` rounding: the result exceeds the exact distance (the distance between two `f32`
-/// values is `0` or at least `2^-149`, where `f64` is exact).
+/// `f32` (so it lies in `[min, max]`), and the extent the smallest `f32` at least the exact
+/// distance to the farther face ([`distance_up`]). That distance is at most
+/// `max(|min|, |max|) <= f32::MAX`, so the extent is finite for every finite box: a box
+/// reaching `±f32::MAX` is stored as it is, not as an infinite one.
 pub(crate) fn outward(min: [f32; 3], max: [f32; 3]) -> ([f32; 3], [f32; 3]) {
     let mut center = [0.0; 3];
     let mut extent = [0.0; 3];
     for k in 0..3 {
         let c = min[k] * 0.5 + max[k] * 0.5;
-        let (lo, hi, c64) = (f64::from(min[k]), f64::from(max[k]), f64::from(c));
-        let d = (hi - c64).max(c64 - lo);
         center[k] = c;
-        extent[k] = if d > 0.0 { round_up(d).next_up() } else { 0.0 };
+        extent[k] = distance_up(c, max[k]).max(distance_up(min[k], c));
     }
     (center, extent)
 }
@@ -90,8 +99,12 @@ pub trait Layout: Store + Clone + core::fmt::Debug {}
 pub(crate) trait Store {
     /// The layout over `children`, whose node `i` has the exact box `[min[i], max[i]]`.
     fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self;
-    /// Node `i` as `(center, extent)`.
+    /// Node `i` as `(center, extent)`, as the queries read it.
     fn node_box(&self, i: u32) -> (Vec3A, Vec3A);
+    /// Node `i` as stored, `(center, extent)` in `f64`: finite for every finite tree (the
+    /// `f32` read-back of a quantized node may overflow where this does not), within two
+    /// `f64` roundings of the exact values.
+    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3);
     /// The children of node `i`.
     fn children(&self, i: u32) -> [Ref; 2];
     /// The number of nodes.
@@ -128,6 +141,10 @@ impl Store for Compact {
     fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
         let n = &self.nodes[i as usize];
         (Vec3A::from_array(n.center), Vec3A::from_array(n.extent))
+    }
+    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3) {
+        let (c, e) = self.node_box(i);
+        (c.as_dvec3(), e.as_dvec3())
     }
     #[inline(always)]
     fn children(&self, i: u32) -> [Ref; 2] {
@@ -238,6 +255,14 @@ impl Store for Quantized {
         // step·c and step·e are exact (a power of two times a 16-bit integer); the sum
         // rounds once (relative u), which the query pad's box-rounding term covers.
         (self.origin + self.step * c, self.step * e)
+    }
+    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3) {
+        let n = &self.nodes[i as usize];
+        let c = DVec3::from_array(n.center.map(f64::from));
+        let e = DVec3::from_array(n.extent.map(f64::from));
+        // step·c and step·e exact (at most 2^113 · 2^16), the sum rounded once.
+        let step = self.step.as_dvec3();
+        (self.origin.as_dvec3() + step * c, step * e)
     }
     #[inline(always)]
     fn children(&self, i: u32) -> [Ref; 2] {

@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3A};
 
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Layout, Ref, Store};
-use super::relative::Relative;
+use super::relative::{QueryError, Relative};
 use super::triangle::{triangles_distance_sq, triangles_intersect};
 use crate::transform::{Rigid3, Similarity3};
 
@@ -74,19 +74,23 @@ pub struct Query<'a, A, B> {
 }
 
 impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
-    /// The query between `a` at `pa` and `b` at `pb`, with no tolerance.
-    #[must_use]
-    pub fn new(a: &'a A, pa: Rigid3, b: &'a B, pb: Rigid3) -> Self {
+    /// The query between `a` at `pa` and `b` at `pb`, with no tolerance; a non-finite pose,
+    /// or a relative pose out of range, is a [`QueryError`] (never a silent "no contact").
+    pub fn new(a: &'a A, pa: Rigid3, b: &'a B, pb: Rigid3) -> Result<Self, QueryError> {
         Self::similarity(a, pa.into(), b, pb.into())
     }
 
     /// The query between `a` at `pa` and `b` at `pb`, poses with a uniform scale (see
-    /// [`Relative::similarity`]; a zero scale places nothing).
-    #[must_use]
-    pub fn similarity(a: &'a A, pa: Similarity3, b: &'a B, pb: Similarity3) -> Self {
+    /// [`Relative::similarity`]; a zero scale is [`QueryError::ZeroScale`]).
+    pub fn similarity(
+        a: &'a A,
+        pa: Similarity3,
+        b: &'a B,
+        pb: Similarity3,
+    ) -> Result<Self, QueryError> {
         let relative =
-            Relative::similarity(&pa, a.hierarchy().reach, &pb, b.hierarchy().reach, 0.0);
-        Query {
+            Relative::similarity(&pa, a.hierarchy().reach, &pb, b.hierarchy().reach, 0.0)?;
+        Ok(Query {
             a,
             b,
             pa,
@@ -94,24 +98,23 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             tolerance: 0.0,
             cross_near_leaves: false,
             relative,
-        }
+        })
     }
 
     /// Pairs at distance at most `tolerance` count as overlapping (NaN, infinite or
-    /// negative: the query reports nothing). The boxes are culled conservatively for the
-    /// exact distance; the leaf distance is computed in `f64` (relative error a few
+    /// negative: [`QueryError::InvalidTolerance`]). The boxes are culled conservatively for
+    /// the exact distance; the leaf distance is computed in `f64` (relative error a few
     /// `2^-52`), so only a zero tolerance is an exact test.
-    #[must_use]
-    pub fn with_tolerance(mut self, tolerance: f32) -> Self {
-        self.tolerance = tolerance;
+    pub fn with_tolerance(mut self, tolerance: f32) -> Result<Self, QueryError> {
         self.relative = Relative::similarity(
             &self.pa,
             self.a.hierarchy().reach,
             &self.pb,
             self.b.hierarchy().reach,
             tolerance,
-        );
-        self
+        )?;
+        self.tolerance = tolerance;
+        Ok(self)
     }
 
     /// Also test the 9 cross axes (in `f64`) on every pair of primitive boxes before the
@@ -147,9 +150,6 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         leaf: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let rel = &self.relative;
-        if !rel.is_valid() {
-            return ControlFlow::Continue(());
-        }
         let (ha, hb) = (self.a.hierarchy(), self.b.hierarchy());
         let box_a = |r: Ref| ha.box_of(r, |i| self.a.primitive_box(i));
         let box_b = |r: Ref| hb.box_of(r, |i| self.b.primitive_box(i));
@@ -279,49 +279,49 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, AabbTree<LA>, AabbTree<LB>> {
 }
 
 impl<L: Layout> TriMesh<L> {
-    /// The query between this mesh at `pose` and `other` at `other_pose`.
-    #[must_use]
+    /// The query between this mesh at `pose` and `other` at `other_pose` (see
+    /// [`Query::new`] for the errors).
     pub fn query<'a, M: Layout>(
         &'a self,
         pose: Rigid3,
         other: &'a TriMesh<M>,
         other_pose: Rigid3,
-    ) -> Query<'a, Self, TriMesh<M>> {
+    ) -> Result<Query<'a, Self, TriMesh<M>>, QueryError> {
         Query::new(self, pose, other, other_pose)
     }
 
-    /// True when this mesh at `pose` meets `other` at `other_pose` (first contact).
-    #[must_use]
+    /// True when this mesh at `pose` meets `other` at `other_pose` (first contact); a bad
+    /// pose is a [`QueryError`].
     pub fn intersects<M: Layout>(
         &self,
         pose: Rigid3,
         other: &TriMesh<M>,
         other_pose: Rigid3,
-    ) -> bool {
-        self.query(pose, other, other_pose).intersects()
+    ) -> Result<bool, QueryError> {
+        Ok(self.query(pose, other, other_pose)?.intersects())
     }
 
-    /// Every pair of triangle ids (this mesh's, `other`'s) that meet at these poses.
-    #[must_use]
+    /// Every pair of triangle ids (this mesh's, `other`'s) that meet at these poses; a bad
+    /// pose is a [`QueryError`].
     pub fn overlapping_triangles<M: Layout>(
         &self,
         pose: Rigid3,
         other: &TriMesh<M>,
         other_pose: Rigid3,
-    ) -> Vec<(u32, u32)> {
-        self.query(pose, other, other_pose).overlapping_triangles()
+    ) -> Result<Vec<(u32, u32)>, QueryError> {
+        Ok(self.query(pose, other, other_pose)?.overlapping_triangles())
     }
 }
 
 impl<L: Layout> AabbTree<L> {
-    /// The query between this tree at `pose` and `other` at `other_pose`.
-    #[must_use]
+    /// The query between this tree at `pose` and `other` at `other_pose` (see
+    /// [`Query::new`] for the errors).
     pub fn query<'a, M: Layout>(
         &'a self,
         pose: Rigid3,
         other: &'a AabbTree<M>,
         other_pose: Rigid3,
-    ) -> Query<'a, Self, AabbTree<M>> {
+    ) -> Result<Query<'a, Self, AabbTree<M>>, QueryError> {
         Query::new(self, pose, other, other_pose)
     }
 }

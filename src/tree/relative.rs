@@ -57,7 +57,12 @@
 //! **Overflow.** The proof assumes no `f32` operation overflows: every value in the tests is
 //! at most `(1 + m)(R_a + R_b + T) + P`. When `(1 + m)(R_a + R_b + T) >= 2^126`, `P` is
 //! `+inf` instead and no pair is culled (an infinite radius never separates; NaN never
-//! separates); the exact leaf test still decides. Found by the `tree` fuzz target.
+//! separates); the exact leaf test still decides. Found by the `tree` fuzz target. The
+//! reaches are `f64` and finite for every finite tree (a node reaching `±f32::MAX` whose
+//! `f32` read-back overflows is such a case: its reach is past `2^126`). What cannot be
+//! decided is an error, never "no contact": a non-finite pose, a zero scale, a bad
+//! tolerance, or a map that overflows `f64` or places `B` beyond `2^300` (the leaf test's
+//! exact range) is a [`QueryError`].
 //!
 //! At the root the 9 cross axes `e_i × M_j` (`M_j` a column of `M`) are tested as well, in
 //! `f64` ([`Relative::roots_separated`]): on axis `L` separated when
@@ -66,6 +71,7 @@
 //! by the radii plus `‖L‖₁·(δ_a + m·δ_b + |w|) <= ‖L‖₁·P`, and the `f64` evaluation errs by
 //! far less than the second term.
 
+use crate::extended::round_up;
 use crate::math::{pow2, sqrt};
 use glam::{DMat3, DVec3, Quat, Vec3A};
 
@@ -87,6 +93,83 @@ fn rotation(q: Quat) -> DMat3 {
     )
 }
 
+/// Which object of a query an error is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Object {
+    /// The first object (`A`, at `pa`).
+    A,
+    /// The second object (`B`, at `pb`).
+    B,
+}
+
+/// Why a query (or a [`Relative`]) could not be set up: it would not decide the geometry,
+/// so it reports this instead of "no contact".
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum QueryError {
+    /// A pose has a NaN or infinite rotation, translation or scale.
+    NonFinitePose {
+        /// The object whose pose it is.
+        object: Object,
+    },
+    /// A pose has a zero scale: the object is a point, and `B` cannot be placed in a frame
+    /// scaled by zero.
+    ZeroScale {
+        /// The object whose pose it is.
+        object: Object,
+    },
+    /// The tolerance is NaN, infinite or negative.
+    InvalidTolerance {
+        /// The tolerance given.
+        tolerance: f32,
+    },
+    /// A reach given to [`Relative::new`] is NaN, infinite or negative.
+    InvalidReach {
+        /// The reach given.
+        reach: f64,
+    },
+    /// The relative map overflows `f64`, or places `B`'s boxes beyond `2^300`, past the range
+    /// where the leaf test is exact (non-unit quaternions or scale ratios near the ends of
+    /// the `f32` range).
+    OutOfRange,
+}
+
+impl core::fmt::Display for QueryError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::NonFinitePose { object } => {
+                write!(f, "the pose of {object:?} has a NaN or infinite component")
+            }
+            Self::ZeroScale { object } => write!(f, "the pose of {object:?} has a zero scale"),
+            Self::InvalidTolerance { tolerance } => {
+                write!(f, "tolerance {tolerance} is NaN, infinite or negative")
+            }
+            Self::InvalidReach { reach } => write!(f, "reach {reach} is NaN, infinite or negative"),
+            Self::OutOfRange => write!(
+                f,
+                "the relative pose overflows, or places B beyond 2^300 (outside the exact range)"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for QueryError {}
+
+/// The largest `|coordinate|` of a placed box the leaf test takes: `2^300`, so that the
+/// products of three differences in `orient3d` (at most `2^903`) stay far from overflow.
+const PLACED_LIMIT: f64 = pow2(300);
+
+/// A pose's components are finite and its scale is not zero.
+fn check_pose(p: &Similarity3, object: Object) -> Result<(), QueryError> {
+    let finite = p.rotation.is_finite() && p.translation.is_finite() && p.scale.is_finite();
+    if !finite {
+        return Err(QueryError::NonFinitePose { object });
+    }
+    if p.scale == 0.0 {
+        return Err(QueryError::ZeroScale { object });
+    }
+    Ok(())
+}
+
 /// `B`'s frame in `A`'s frame for one query: `M`, `t`, their `f32` copies and the pad.
 #[derive(Clone, Copy, Debug)]
 pub struct Relative {
@@ -100,31 +183,45 @@ pub struct Relative {
     t32: Vec3A,
     t_b: Vec3A,
     pad: f32,
-    valid: bool,
 }
 
 impl Relative {
     /// The relative pose of `B` (at `pb`, every box within `reach_b` of its origin on every
     /// axis) in `A`'s frame (at `pa`, `reach_a`), with tolerance `tolerance` (pairs closer
-    /// than it count as overlapping). A non-finite pose, reach or tolerance, or a negative
-    /// one, gives a relative pose that places nothing ([`Relative::is_valid`] is false).
-    #[must_use]
-    pub fn new(pa: &Rigid3, reach_a: f32, pb: &Rigid3, reach_b: f32, tolerance: f32) -> Self {
+    /// than it count as overlapping). A non-finite pose, a NaN, infinite or negative reach
+    /// or tolerance, or a map out of range is a [`QueryError`].
+    pub fn new(
+        pa: &Rigid3,
+        reach_a: f64,
+        pb: &Rigid3,
+        reach_b: f64,
+        tolerance: f32,
+    ) -> Result<Self, QueryError> {
         Self::similarity(&(*pa).into(), reach_a, &(*pb).into(), reach_b, tolerance)
     }
 
     /// The same for poses with a uniform scale: `M = (σb/σa)·R(qa)ᵀ·R(qb)`,
     /// `t = R(qa)ᵀ·(tb − ta)/σa`, and `B`'s axes tested through `N = (σa/σb)²·Mᵀ` (the
     /// inverse of `M` for unit quaternions; for [`Rigid3`], `σ = 1` and `N = Mᵀ`). A zero
-    /// scale places nothing.
-    #[must_use]
+    /// scale is [`QueryError::ZeroScale`]; a negative one reflects.
     pub fn similarity(
         pa: &Similarity3,
-        reach_a: f32,
+        reach_a: f64,
         pb: &Similarity3,
-        reach_b: f32,
+        reach_b: f64,
         tolerance: f32,
-    ) -> Self {
+    ) -> Result<Self, QueryError> {
+        check_pose(pa, Object::A)?;
+        check_pose(pb, Object::B)?;
+        if let Some(&reach) = [reach_a, reach_b]
+            .iter()
+            .find(|r| !(r.is_finite() && **r >= 0.0))
+        {
+            return Err(QueryError::InvalidReach { reach });
+        }
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(QueryError::InvalidTolerance { tolerance });
+        }
         let (sa, sb) = (f64::from(pa.scale), f64::from(pb.scale));
         let ra_t = rotation(pa.rotation).transpose();
         let m = ra_t * rotation(pb.rotation) * (sb / sa);
@@ -134,25 +231,17 @@ impl Relative {
         } else {
             m.transpose() * ((sa / sb) * (sa / sb))
         };
+        let t_b = -(n * t);
+        // Every placed vertex lies within `|M|·reach_b + |t|` (not `<=`-negated: NaN fails).
+        let placed = abs_sum(&m) * reach_b + t.abs().max_element();
+        let finite = m.is_finite() && n.is_finite() && t.is_finite() && t_b.is_finite();
+        if !(finite && placed <= PLACED_LIMIT) {
+            return Err(QueryError::OutOfRange);
+        }
         let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.as_vec3a());
         // The columns of N (for a rotation, the rows of M).
         let rows = [n.x_axis, n.y_axis, n.z_axis].map(|c| c.as_vec3a());
-        let t_b = -(n * t);
-        let finite = m.is_finite()
-            && n.is_finite()
-            && t.is_finite()
-            && reach_a.is_finite()
-            && reach_b.is_finite()
-            && tolerance.is_finite()
-            && reach_a >= 0.0
-            && reach_b >= 0.0
-            && tolerance >= 0.0;
-        let pad = if finite {
-            pad(&m, &n, t, t_b, reach_a, reach_b, tolerance)
-        } else {
-            f32::NAN
-        };
-        Relative {
+        Ok(Relative {
             m,
             n,
             t,
@@ -162,16 +251,8 @@ impl Relative {
             abs_rows: rows.map(Vec3A::abs),
             t32: t.as_vec3a(),
             t_b: t_b.as_vec3a(),
-            pad,
-            valid: finite,
-        }
-    }
-
-    /// False when an input was NaN, infinite or negative: such a query reports nothing.
-    #[inline]
-    #[must_use]
-    pub fn is_valid(&self) -> bool {
-        self.valid
+            pad: pad(&m, &n, t, t_b, reach_a, reach_b, tolerance),
+        })
     }
 
     /// `M = R(qa)ᵀ·R(qb)` in `f64`.
@@ -227,7 +308,7 @@ impl Relative {
     /// [`Relative::new`]. An empty box never overlaps; NaN faces always do (conservative).
     #[must_use]
     pub fn overlaps(&self, a: &crate::Aabb3, b: &crate::Aabb3) -> bool {
-        if !self.valid || a.min.cmpgt(a.max).any() || b.min.cmpgt(b.max).any() {
+        if a.min.cmpgt(a.max).any() || b.min.cmpgt(b.max).any() {
             return false;
         }
         self.overlaps_ce(a.center(), a.half_extents(), b.center(), b.half_extents())
@@ -265,21 +346,23 @@ impl Relative {
     }
 
     /// The `f64` margin of the root cross-axis test: `2^-46·(1 + m)(R_a + R_b + T)`.
-    pub(crate) fn cross_margin(&self, reach_a: f32, reach_b: f32) -> f64 {
+    pub(crate) fn cross_margin(&self, reach_a: f64, reach_b: f64) -> f64 {
         let (m, t) = norms(&self.m, &self.n, self.t, self.t_b.as_dvec3());
-        pow2(-46) * (1.0 + m) * (f64::from(reach_a) + f64::from(reach_b) + t)
+        pow2(-46) * (1.0 + m) * (reach_a + reach_b + t)
     }
+}
+
+/// The largest row or column sum of `|m|`.
+fn abs_sum(m: &DMat3) -> f64 {
+    let abs = DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+    let cols = [abs.x_axis, abs.y_axis, abs.z_axis].map(DVec3::element_sum);
+    let rows = (0..3).map(|i| abs.row(i).element_sum());
+    rows.chain(cols).fold(0.0, f64::max)
 }
 
 /// `m` (largest row or column sum of `|M|` or `|N|`) and `T` (largest `|t_i|` or `|t_B,i|`).
 fn norms(m: &DMat3, n: &DMat3, t: DVec3, t_b: DVec3) -> (f64, f64) {
-    let sums = |m: &DMat3| {
-        let abs = DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
-        let cols = [abs.x_axis, abs.y_axis, abs.z_axis].map(DVec3::element_sum);
-        let rows = (0..3).map(|i| abs.row(i).element_sum());
-        rows.chain(cols).fold(0.0, f64::max)
-    };
-    let m = sums(m).max(sums(n)) * (1.0 + pow2(-40));
+    let m = abs_sum(m).max(abs_sum(n)) * (1.0 + pow2(-40));
     let t = t.abs().max_element().max(t_b.abs().max_element()) * (1.0 + pow2(-40));
     (m, t)
 }
@@ -290,13 +373,13 @@ fn pad(
     n: &DMat3,
     t: DVec3,
     t_b: DVec3,
-    reach_a: f32,
-    reach_b: f32,
+    reach_a: f64,
+    reach_b: f64,
     tolerance: f32,
 ) -> f32 {
     let (mm, tt) = norms(m, n, t, t_b);
     let grow = 1.0 + pow2(-18);
-    let (ra, rb) = (f64::from(reach_a) * grow, f64::from(reach_b) * grow);
+    let (ra, rb) = (reach_a * grow, reach_b * grow);
     let tiny = pow2(-148);
     let (delta_a, delta_b) = (2.0 * U * ra + tiny, 2.0 * U * rb + tiny);
     let max_entry = [m.x_axis, m.y_axis, m.z_axis, n.x_axis, n.y_axis, n.z_axis]
@@ -324,11 +407,5 @@ fn pad(
         + tiny
         + frob * sqrt(3.0) * rb
         + 12.0 * U * (1.0 + mm) * (ra + rb + tt);
-    let p = sum * (1.0 + pow2(-20));
-    let p32 = p as f32;
-    if f64::from(p32) < p {
-        p32.next_up()
-    } else {
-        p32
-    }
+    round_up(sum * (1.0 + pow2(-20)))
 }
