@@ -172,7 +172,7 @@ pub(crate) fn transform<const N: usize>(
 
 /// Knuth's TwoSum in `f64`: `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly.
 #[inline]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let b_virtual = s - a;
     let a_virtual = s - b_virtual;
