@@ -19,38 +19,15 @@
 
 mod meshes;
 mod oracle;
+mod volumes;
 
 use bvkit::{Aabb3, Capsule, Fit, FitError, Obb3, Sphere};
 use glam::{Mat3A, Quat, Vec3, Vec3A};
 use num_bigint::BigInt;
 use num_traits::Signed;
-use oracle::Exact;
+use volumes::points::{self, cross, dot, fixed, fixed3};
 
 const MODES: [Fit; 3] = [Fit::Pca, Fit::Fast, Fit::Tight];
-
-/// `x·2^149`, exactly.
-fn fixed(x: f32) -> BigInt {
-    match Exact::of(x) {
-        Exact::Finite(v) => v >> (oracle::SCALE - 149) as usize,
-        _ => panic!("finite values only"),
-    }
-}
-
-fn fixed3(v: Vec3A) -> [BigInt; 3] {
-    v.to_array().map(fixed)
-}
-
-fn sub(a: &[BigInt; 3], b: &[BigInt; 3]) -> [BigInt; 3] {
-    core::array::from_fn(|i| &a[i] - &b[i])
-}
-
-fn dot(a: &[BigInt; 3], b: &[BigInt; 3]) -> BigInt {
-    (0..3).map(|i| &a[i] * &b[i]).sum()
-}
-
-fn cross(a: &[BigInt; 3], b: &[BigInt; 3]) -> [BigInt; 3] {
-    core::array::from_fn(|i| &a[(i + 1) % 3] * &b[(i + 2) % 3] - &a[(i + 2) % 3] * &b[(i + 1) % 3])
-}
 
 /// A fitted volume and its containment statement, decided exactly.
 trait Volume: Copy + std::fmt::Debug {
@@ -82,11 +59,7 @@ impl Volume for Obb3 {
         Obb3::fit(points, fit)
     }
     fn holds_exactly(&self, p: Vec3A) -> bool {
-        let d = sub(&fixed3(p), &fixed3(self.center));
-        (0..3).all(|k| {
-            let s = dot(&d, &fixed3(self.rotation.col(k)));
-            s.abs() <= fixed(self.half_extents[k]) << 149usize
-        })
+        points::in_box(self, p)
     }
     fn is_finite(&self) -> bool {
         self.center.is_finite() && self.half_extents.is_finite() && self.rotation.is_finite()
@@ -137,9 +110,7 @@ impl Volume for Sphere {
         Sphere::fit(points, fit)
     }
     fn holds_exactly(&self, p: Vec3A) -> bool {
-        let d = sub(&fixed3(p), &fixed3(self.center));
-        let r = fixed(self.radius);
-        dot(&d, &d) <= &r * &r
+        points::in_ball(self, p)
     }
     fn is_finite(&self) -> bool {
         self.center.is_finite() && self.radius.is_finite()
@@ -177,18 +148,7 @@ impl Volume for Capsule {
         Capsule::fit(points, fit)
     }
     fn holds_exactly(&self, p: Vec3A) -> bool {
-        let (a, b, p) = (fixed3(self.a), fixed3(self.b), fixed3(p));
-        let r2 = fixed(self.radius).pow(2);
-        let (v, w) = (sub(&p, &a), sub(&b, &a));
-        let (vw, ww) = (dot(&v, &w), dot(&w, &w));
-        if vw <= BigInt::ZERO || ww == BigInt::ZERO {
-            dot(&v, &v) <= r2
-        } else if vw >= ww {
-            let u = sub(&p, &b);
-            dot(&u, &u) <= r2
-        } else {
-            dot(&v, &v) * &ww - &vw * &vw <= r2 * ww
-        }
+        points::in_capsule(self, p)
     }
     fn is_finite(&self) -> bool {
         self.a.is_finite() && self.b.is_finite() && self.radius.is_finite()
@@ -221,17 +181,6 @@ impl Volume for Capsule {
             radius: self.radius * s,
         }
     }
-}
-
-/// True when `p = c + R·u` with `|u_k| <= h_k` for the box's `f32` fields, exactly (the
-/// corner reading; module docs).
-fn holds_as_corners(obb: &Obb3, p: Vec3A) -> bool {
-    let a = [0, 1, 2].map(|k| fixed3(obb.rotation.col(k)));
-    let dual = [0, 1, 2].map(|k| cross(&a[(k + 1) % 3], &a[(k + 2) % 3]));
-    let det = dot(&a[0], &dual[0]).abs();
-    let d = sub(&fixed3(p), &fixed3(obb.center));
-    det != BigInt::ZERO
-        && (0..3).all(|k| dot(&d, &dual[k]).abs() << 149usize <= fixed(obb.half_extents[k]) * &det)
 }
 
 /// Every mesh the containment tests run on, degenerate ones included.
@@ -620,7 +569,7 @@ fn fits_or_overflows<V: Volume>(points: &[Vec3], fitted: Result<V, FitError>, wh
 fn check_corners(points: &[Vec3], obb: &Obb3, what: &str) {
     for &p in points {
         assert!(
-            holds_as_corners(obb, p.into()),
+            points::in_box_as_corners(obb, p.into()),
             "{what}: {p} outside the corners of {obb:?}"
         );
     }
@@ -813,7 +762,7 @@ fn every_point_lies_in_every_box_as_corners() {
             assert!(
                 points
                     .iter()
-                    .any(|&p| !holds_as_corners(&smaller, p.into())),
+                    .any(|&p| !points::in_box_as_corners(&smaller, p.into())),
                 "{mode:?} {name}: not tight"
             );
         }
