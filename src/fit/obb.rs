@@ -274,8 +274,9 @@ fn orthonormality_defect(rotation: Mat3A) -> Result<Vec3A, FitError> {
 /// A point with `s = Rᵀ(p − c)`, `|s_k| <= h_k`, is `p = c + R·u` with `u = (I + E)⁻¹ s`
 /// (`R` is invertible as `n < 1`). From `u = s − E·u`: `‖u‖∞ <= ‖s‖∞ + n·‖u‖∞`, so
 /// `‖u‖∞ <= H/(1 − n)` with `H = max_j h_j`, and `|u_k| <= h_k + r_k·H/(1 − n)`. That sum
-/// rounds 3 times (`1 − n`, the quotient, the sum; `r_k·H` is exact), all terms positive:
-/// the lemma with `scale = 0` rounds it up. A row with `r_k = 0` keeps `h_k` as it is.
+/// rounds 4 times (`1 − n`, the quotient, the product with `r_k`, the sum), all terms
+/// positive, so within `γ(4)` of it relative: the lemma with `scale = 0` rounds it up. A row
+/// with `r_k = 0` keeps `h_k` as it is.
 fn widened(h: Vec3A, r: Vec3A) -> Vec3A {
     let reach = f64::from(h.max_element()) / (1.0 - f64::from(r.max_element()));
     Vec3A::from_array([0, 1, 2].map(|k| {
