@@ -121,3 +121,59 @@ perspective = [[1.0, 0, 0, 0], [0, 1.5, 0, 0], [0, 0, -1.0, -1.0], [0, 0, -0.1, 
 (root / "mat4" / "nan_entry").write_bytes(mat4([[NAN, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], [0.0] * 3, [1.0] * 3, 0))
 (root / "mat4" / "unbounded_projective").write_bytes(mat4(perspective, [-1.0, -1.0, -INF], [1.0, 1.0, -1.0], 1))
 print("seeds written under", root)
+
+# fit: a choice byte (mode = choice % 3; box, sphere, capsule, from_axes = choice / 3 % 4),
+# the point count, the points; for from_axes a rotation (selector 0, a quaternion); then a
+# probe point, a probe kind (0 box, 1 sphere, 2 capsule) and that volume's raw fields.
+TILT = [0.2, -0.3, 0.1, math.sqrt(1 - 0.14)]
+FIT_CLASSES = {
+    "typical": [[0.0, 0.0, 0.0], [1.0, 0.2, -0.5], [0.3, 2.0, 0.1], [-0.4, 0.5, 1.5], [0.7, -1.0, 0.9]],
+    "flat_parallel": [[1e-30, 2e-30, 0.0], [1e30, 1e30, 0.0], [-1e30, -1e30, 0.0]],
+    "near_max": [[MAX, MAX, 0.0], [MAX / 2, MAX, MAX * 0.75], [MAX, MAX / 2, MAX]],
+    "spread_max": [[-MAX, -MAX, -MAX], [MAX, MAX, MAX], [MAX, -MAX, 0.0]],
+    "subnormal": [[TINY, 0.0, 0.0], [0.0, 3 * TINY, 0.0], [0.0, 0.0, 2 * TINY], [TINY, TINY, TINY]],
+    "far_1e9": [[1e9, 1e9, -1e9], [1e9 + 64, 1e9, -1e9], [1e9, 1e9 + 128, -1e9 + 64]],
+    "collinear": [[0.0, 0.0, 0.0], [1.0, 2.0, 3.0], [-2.0, -4.0, -6.0], [0.5, 1.0, 1.5]],
+    "one_point": [[1.5, -2.25, 1e-3]],
+    "duplicates": [[1.0, 2.0, 3.0]] * 3 + [[-1.0, 0.0, 1.0]] * 2,
+    "signed_zero": [[-0.0, 0.0, -0.0], [0.0, -0.0, 0.0], [1.0, -0.0, 0.0]],
+    "nan": [[0.0, 0.0, 0.0], [1.0, NAN, 0.0]],
+    "inf": [[0.0, INF, 0.0], [1.0, 1.0, 1.0]],
+    "empty": [],
+}
+(root / "fit").mkdir(parents=True, exist_ok=True)
+for c, (name, points) in enumerate(FIT_CLASSES.items()):
+    for kind in range(4):
+        choice = kind * 3 + (c + kind) % 3
+        body = bytes([choice, len(points)]) + b"".join(f(x) for p in points for x in p)
+        if kind == 3:
+            body += bytes([0]) + b"".join(map(f, TILT))
+        probe = b"".join(map(f, [0.5, 0.25, -0.5]))
+        volume = [
+            bytes([0]) + b"".join(map(f, [0.0, 0.0, 0.0, 1.0, 1.0, 1.0])) + bytes([0]) + b"".join(map(f, TILT)),
+            bytes([1]) + b"".join(map(f, [0.0, 0.0, 0.0, 1.0])),
+            bytes([2]) + b"".join(map(f, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.5])),
+        ][kind % 3]
+        (root / "fit" / f"{name}_{kind}").write_bytes(body + probe + volume)
+
+# volume_world: a class byte (translation, rigid, similarity, trs, affine; 5 = images under a
+# similarity), a kind byte (box, sphere, capsule), the class's problem, then the volume's
+# raw fields from the problem's box (a box also takes a rotation: selector 0, a quaternion).
+(root / "volume_world").mkdir(parents=True, exist_ok=True)
+for name, (cols, t, lo, hi) in classes3.items():
+    order = 0 if name == "empty" else 1
+    data3 = problem3(cols, t, lo, hi, order)
+    q, scale = QUATS[name]
+    quat = b"".join(map(f, q))
+    half = [(h - l) / 2 if math.isfinite(h - l) else h for l, h in zip(lo, hi)]
+    fields = [
+        b"".join(map(f, lo + half)) + bytes([0]) + b"".join(map(f, TILT)),
+        b"".join(map(f, hi + [half[0]])),
+        b"".join(map(f, lo + hi + [half[1]])),
+    ]
+    problems = [data3, data3 + quat, data3 + quat + f(scale[0]), data3 + quat + b"".join(map(f, scale)), data3]
+    for k in range(3):
+        cls = (k + len(name)) % 5
+        (root / "volume_world" / f"{name}_{k}").write_bytes(bytes([cls, k]) + problems[cls] + fields[k])
+    images = data3 + quat + f(scale[0]) + b"".join(fields)
+    (root / "volume_world" / f"{name}_images").write_bytes(bytes([5, 1]) + images)

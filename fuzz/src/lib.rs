@@ -4,9 +4,12 @@
 #[path = "../../tests/oracle/mod.rs"]
 pub mod oracle;
 
+#[path = "../../tests/volumes/mod.rs"]
+pub mod volumes;
+
 use bvkit::tree::{Object, QueryError};
-use bvkit::{Aabb2, Method, Rigid2, Rounding, Similarity3};
-use glam::{Quat, Vec3A};
+use bvkit::{Aabb2, Capsule, Method, Obb3, Rigid2, Rounding, Similarity3, Sphere};
+use glam::{Mat3A, Quat, Vec3A};
 use oracle::{Bound, Exactly, Problem, QuatProblem};
 
 pub use oracle::{affine2, affine3};
@@ -100,6 +103,53 @@ impl<'a> Floats<'a> {
             t: p.t,
             lo: p.lo,
             hi: p.hi,
+        }
+    }
+
+    /// A point of three floats.
+    pub fn vec3a(&mut self) -> Vec3A {
+        Vec3A::from_array(self.array())
+    }
+
+    /// A rotation: usually `Mat3A::from_quat` of a normalised quaternion (orthonormal to
+    /// within `f32` rounding), sometimes one with a drifted entry, sometimes nine raw floats.
+    pub fn rotation(&mut self) -> Mat3A {
+        let selector = self.byte();
+        let turn = Mat3A::from_quat(Quat::from_array(self.array()).normalize());
+        match selector % 4 {
+            0 | 1 => turn,
+            2 => {
+                let mut cols = turn.to_cols_array();
+                cols[self.byte() as usize % 9] += self.next() * 1e-4;
+                Mat3A::from_cols_array(&cols)
+            }
+            _ => Mat3A::from_cols_array(&self.array()),
+        }
+    }
+
+    /// A box from raw fields (its rotation from [`Floats::rotation`]).
+    pub fn obb(&mut self) -> Obb3 {
+        Obb3 {
+            center: self.vec3a(),
+            half_extents: self.vec3a(),
+            rotation: self.rotation(),
+        }
+    }
+
+    /// A ball from raw fields.
+    pub fn sphere(&mut self) -> Sphere {
+        Sphere {
+            center: self.vec3a(),
+            radius: self.next(),
+        }
+    }
+
+    /// A capsule from raw fields.
+    pub fn capsule(&mut self) -> Capsule {
+        Capsule {
+            a: self.vec3a(),
+            b: self.vec3a(),
+            radius: self.next(),
         }
     }
 

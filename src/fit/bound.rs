@@ -17,6 +17,7 @@
 //!
 //! Callers name the roundings of their expression next to each use.
 
+use crate::extended::two_sum;
 use glam::DVec3;
 
 /// The relative pad `2^-48`, four times the worst error `γ(8) < 2^-49.9` of the evaluations.
@@ -103,4 +104,32 @@ pub(crate) fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> Bounded {
         value: (ap - ab * t).length(),
         scale: ap.abs().element_sum() + t * ab.abs().element_sum(),
     }
+}
+
+/// A bound on `|Σ terms|` that is 0 when no partial sum rounds and the sum is 0.
+///
+/// TwoSum gives each partial sum `s_i = fl(s_{i-1} + t_i)` with its exact error `e_i`, so
+/// `Σ terms = s_N + Σ_i e_i` exactly and `|Σ terms| <= |s_N| + Σ_i |e_i|`. That bound is
+/// returned as evaluated in `f64`: `N − 1` roundings of non-negative terms, within
+/// `γ(N − 1)` of it relative (callers count them in the lemma's form).
+#[inline]
+#[must_use]
+pub(crate) fn sum_magnitude<const N: usize>(terms: [f64; N]) -> f64 {
+    let (mut sum, mut errors) = (0.0, 0.0);
+    for t in terms {
+        let (s, e) = two_sum(sum, t);
+        sum = s;
+        errors += e.abs();
+    }
+    sum.abs() + errors
+}
+
+/// The largest of `values` (0 for none), or `None` when one is NaN or infinite: the radius
+/// of a fitted volume, which must not drop a NaN (as `f32::max` does) nor overflow.
+#[inline]
+#[must_use]
+pub(crate) fn largest(values: impl IntoIterator<Item = f32>) -> Option<f32> {
+    values
+        .into_iter()
+        .try_fold(0.0f32, |r, x| x.is_finite().then(|| r.max(x)))
 }

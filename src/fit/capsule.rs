@@ -1,7 +1,7 @@
 //! Capsules (swept spheres) and their fits.
 
 use super::ball::smallest_ball;
-use super::bound::{Bounded, segment_distance};
+use super::bound::{Bounded, largest, segment_distance};
 use super::cloud::{self, exact};
 use super::eigen::principal_axes;
 use super::obb::{Obb3, tight_frames};
@@ -55,27 +55,34 @@ impl Capsule {
     /// certified from every point.
     ///
     /// # Errors
-    /// [`FitError`] for no points or a non-finite point.
+    /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,
+    /// [`FitError::Overflow`] when the radius would overflow `f32`.
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
-        cloud::validate(points)?;
+        let bounds = cloud::validate(points)?;
         let shape = match fit {
             Fit::Pca => pca_shape(points),
             Fit::Fast => fast_shape(points),
             Fit::Tight => tight_shape(points),
         };
-        Ok(Self::around(points, shape.a, shape.b))
+        Self::around(points, &bounds, shape.a, shape.b)
     }
 
-    /// The capsule on the segment `[a, b]` rounded to `f32`, its radius the largest
-    /// certified distance of a point to it ([`segment_distance`]).
-    fn around(points: &[Vec3], a: DVec3, b: DVec3) -> Self {
-        let (a, b) = (a.as_vec3a(), b.as_vec3a());
+    /// The capsule on the segment `[a, b]`, its ends moved into the points' bounding box
+    /// `bounds` and rounded to `f32` (so finite), its radius the largest certified distance
+    /// of a point to it ([`segment_distance`]).
+    fn around(points: &[Vec3], bounds: &Aabb3, a: DVec3, b: DVec3) -> Result<Self, FitError> {
+        let (a, b) = (
+            cloud::round_within(a, bounds),
+            cloud::round_within(b, bounds),
+        );
         let (ad, bd) = (a.as_dvec3(), b.as_dvec3());
-        let radius = points
-            .iter()
-            .map(|&p| segment_distance(exact(p), ad, bd).upper())
-            .fold(0.0, f32::max);
-        Self { a, b, radius }
+        let radius = largest(
+            points
+                .iter()
+                .map(|&p| segment_distance(exact(p), ad, bd).upper()),
+        )
+        .ok_or(FitError::Overflow)?;
+        Ok(Self { a, b, radius })
     }
 
     /// True when `p` may lie in the capsule: never false for a point of it, true only
@@ -162,10 +169,12 @@ fn circle_shape(points: &[DVec3], dir: DVec3) -> Shape {
     capped(points, origin, dir, radius)
 }
 
-/// The smallest of some capsules.
+/// The smallest of some capsules, skipping degenerate ones (a NaN axis from a degenerate
+/// frame: its volume is NaN, which must never win).
 fn smallest(shapes: impl IntoIterator<Item = Shape>) -> Shape {
     shapes
         .into_iter()
+        .filter(|s| s.volume().is_finite())
         .min_by(|a, b| a.volume().total_cmp(&b.volume()))
         .unwrap_or(Shape {
             a: DVec3::ZERO,

@@ -3,7 +3,7 @@
 use super::FitError;
 use crate::Aabb3;
 use alloc::vec::Vec;
-use glam::{DMat3, DVec3, Vec3};
+use glam::{DMat3, DVec3, Vec3, Vec3A};
 
 /// Checks the input and returns its bounding box: an error for no point or a non-finite one.
 pub(crate) fn validate(points: &[Vec3]) -> Result<Aabb3, FitError> {
@@ -23,6 +23,15 @@ pub(crate) fn validate(points: &[Vec3]) -> Result<Aabb3, FitError> {
 #[inline]
 pub(crate) fn exact(p: Vec3) -> DVec3 {
     p.as_dvec3()
+}
+
+/// `p` moved into the bounding box `bounds` of the points, then rounded to nearest: always
+/// finite (NaN goes to `bounds.min`). A fit's center or axis end may be any point, since its
+/// extents are derived afterwards from every input point; one in the box never overflows.
+#[inline]
+pub(crate) fn round_within(p: DVec3, bounds: &Aabb3) -> Vec3A {
+    p.clamp(bounds.min.as_dvec3(), bounds.max.as_dvec3())
+        .as_vec3a()
 }
 
 /// The distinct points, in a deterministic order (`-0.0` and `0.0` are one coordinate).

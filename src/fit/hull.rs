@@ -77,7 +77,12 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
         .filter(|&i| !collinear(p0, p1, points[i]))
         .unwrap_or(i2);
     let p2 = points[i2];
-    let normal = (p1 - p0).cross(p2 - p0).normalize();
+    // Not collinear, exactly; but the `f64` differences may still round to parallel
+    // vectors (as for (1e-30, 2e-30, 0), (1e30, 1e30, 0), (-1e30, -1e30, 0)): with no
+    // normal to speak of, the set is a segment for the fits' purposes.
+    let Some(normal) = (p1 - p0).cross(p2 - p0).try_normalize() else {
+        return Hull::Segment(axis);
+    };
     let volume = |p: DVec3| orient3d(coord(p0), coord(p1), coord(p2), coord(p));
     let Some(i3) = farthest(&|p| volume(p).abs()).filter(|&i| volume(points[i]) != 0.0) else {
         return Hull::Planar(normal);

@@ -11,7 +11,9 @@
 //! else (eigenvectors, hull, optimisation) has to be exact: it only chooses the shape.
 //!
 //! **Input.** Duplicates and degenerate sets (one point, collinear, planar) are normal input;
-//! an empty slice or a NaN or infinite coordinate is a [`FitError`]. Nothing panics.
+//! an empty slice or a NaN or infinite coordinate is a [`FitError`]. So is a result that
+//! `f32` cannot hold (points spread toward `±f32::MAX`): a fit returns a volume whose fields
+//! are all finite and that contains every point, or an error. Nothing panics.
 
 mod ball;
 mod bound;
@@ -57,6 +59,16 @@ pub enum FitError {
         /// Its coordinates.
         point: [f32; 3],
     },
+    /// The rotation given to [`Obb3::from_axes`] is not orthonormal: it has a NaN or
+    /// infinite entry, or its columns `a_k` are off by more than `2^-10`, measured as
+    /// `max_k Σ_j |a_k·a_j − δ_kj|`.
+    NotOrthonormal {
+        /// That measure, bounded above (NaN for a non-finite entry).
+        defect: f32,
+    },
+    /// The points spread so far toward `±f32::MAX` that the fitted volume does not fit in
+    /// `f32`: a half-extent or a radius would overflow.
+    Overflow,
 }
 
 impl fmt::Display for FitError {
@@ -66,6 +78,14 @@ impl fmt::Display for FitError {
             Self::NonFinite { index, point } => {
                 write!(f, "point {index} is not finite: {point:?}")
             }
+            Self::NotOrthonormal { defect } => write!(
+                f,
+                "the rotation is not orthonormal: defect {defect:e}, at most 2^-10 allowed"
+            ),
+            Self::Overflow => write!(
+                f,
+                "the fitted volume overflows f32: the points spread too far"
+            ),
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Oriented bounding boxes and their fits.
 
-use super::bound::Bounded;
+use super::bound::{Bounded, sum_magnitude};
 use super::cloud::{self, DIRECTIONS, exact};
 use alloc::vec;
 use alloc::vec::Vec;
@@ -29,6 +29,12 @@ use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
 ///
 /// The statement is exact on the `f32` fields as given: fitted rotations are orthonormal to
 /// within `f32` rounding, and the box is the parallelepiped those three slabs cut out.
+///
+/// **Both readings.** As `f32` axes are never exactly orthonormal, the slab set differs
+/// slightly from the set `center + rotation·u` with `|u_k| <= half_extents[k]` (the box
+/// whose corners are `c ± R·h`). A fitted box ([`Obb3::fit`], [`Obb3::from_axes`]) contains
+/// every input point under both readings, exactly: its half-extents are widened by a proven
+/// bound from the measured orthonormality defect of its rotation.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "bytemuck", derive(bytemuck::AnyBitPattern))]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,28 +58,32 @@ enum Center {
 }
 
 impl Obb3 {
-    /// The box fitted to `points` with the given effort.
+    /// The box fitted to `points` with the given effort; it contains every point under
+    /// both readings (see [`Obb3`]).
     ///
     /// # Errors
-    /// [`FitError`] for no points or a non-finite point.
+    /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,
+    /// [`FitError::Overflow`] when a half-extent would overflow `f32`.
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
         let bounds = cloud::validate(points)?;
-        Ok(match fit {
+        match fit {
             Fit::Pca => fit_pca(points, &bounds),
             Fit::Fast => fit_fast(points, &bounds),
             Fit::Tight => fit_tight(points, &bounds),
-        })
+        }
     }
 
     /// The smallest box with the axes of `rotation` (rounded outward, midrange center)
-    /// holding `points`.
+    /// holding `points` under both readings (see [`Obb3`]).
     ///
     /// # Errors
-    /// [`FitError`] for no points or a non-finite point.
+    /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,
+    /// [`FitError::NotOrthonormal`] for a rotation that is not orthonormal to within
+    /// `2^-10`, [`FitError::Overflow`] when a half-extent would overflow `f32`.
     pub fn from_axes(points: &[Vec3], rotation: Mat3A) -> Result<Self, FitError> {
         let bounds = cloud::validate(points)?;
         let [obb] = fit_axes(points, &bounds, [rotation], Center::Midrange);
-        Ok(obb)
+        obb
     }
 
     /// True when `p` may lie in the box: never false for a point of the box, and true only
@@ -164,7 +174,7 @@ fn fit_axes<const N: usize>(
     bounds: &Aabb3,
     rotations: [Mat3A; N],
     center: Center,
-) -> [Obb3; N] {
+) -> [Result<Obb3, FitError>; N] {
     let axes = rotations.map(|r| r.as_dmat3().transpose());
     let mut lo = [DVec3::INFINITY; N];
     let mut hi = [DVec3::NEG_INFINITY; N];
@@ -180,15 +190,26 @@ fn fit_axes<const N: usize>(
 }
 
 /// The certified box with axes `rotation` whose computed projection range is `[lo, hi]`
-/// (see [`fit_axes`]).
-fn certified_box(rotation: Mat3A, lo: DVec3, hi: DVec3, bounds: &Aabb3, center: Center) -> Obb3 {
+/// (see [`fit_axes`]), widened to hold under both readings ([`widened`]); an error for a
+/// rotation that is not orthonormal or a half-extent beyond `f32`.
+///
+/// The center is moved into the points' bounding box before rounding
+/// ([`cloud::round_within`]), so it is finite; the half-extents are derived from it.
+fn certified_box(
+    rotation: Mat3A,
+    lo: DVec3,
+    hi: DVec3,
+    bounds: &Aabb3,
+    center: Center,
+) -> Result<Obb3, FitError> {
+    let defect = orthonormality_defect(rotation)?;
     let axes = [0, 1, 2].map(|k| rotation.col(k).as_dvec3());
     let reach = bounds.min.abs().max(bounds.max.abs()).as_dvec3();
     let c = match center {
         Center::Midrange => (0..3).map(|k| axes[k] * (0.5 * (lo[k] + hi[k]))).sum(),
         Center::At(c) => c,
     };
-    let center = c.as_vec3a();
+    let center = cloud::round_within(c, bounds);
     let cd = center.as_dvec3();
     let half_extent = |k: usize| {
         let cc = cd.dot(axes[k]);
@@ -198,36 +219,100 @@ fn certified_box(rotation: Mat3A, lo: DVec3, hi: DVec3, bounds: &Aabb3, center: 
         }
         .upper()
     };
-    Obb3 {
+    let slabs = Vec3A::new(half_extent(0), half_extent(1), half_extent(2));
+    let half_extents = widened(slabs, defect);
+    if !half_extents.is_finite() {
+        return Err(FitError::Overflow);
+    }
+    Ok(Obb3 {
         center,
-        half_extents: Vec3A::new(half_extent(0), half_extent(1), half_extent(2)),
+        half_extents,
         rotation,
+    })
+}
+
+/// Columns this far from orthonormal (`max_k Σ_j |a_k·a_j − δ_kj|`) are refused.
+const MAX_DEFECT: f32 = 1.0 / 1024.0;
+
+/// Upper bounds `r_k >= Σ_j |E_kj|` on the rows of `E = RᵀR − I`, each 0 when its row is
+/// exactly 0; an error when an entry is not finite or `max_k r_k > 2^-10`.
+///
+/// `E_kj = Σ_i a_ik·a_ij − δ_kj` is a sum of four exact `f64` terms (products of `f32`), so
+/// [`sum_magnitude`] bounds `|E_kj|` with 3 roundings; the row's sum of three such adds 2:
+/// 11 roundings of non-negative terms, within `γ(11) <= 2·γ(8)` of the real bound, which the
+/// lemma covers with `scale = value`.
+fn orthonormality_defect(rotation: Mat3A) -> Result<Vec3A, FitError> {
+    let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3());
+    let entry = |k: usize, j: usize| {
+        let p = a[k] * a[j];
+        sum_magnitude([p.x, p.y, p.z, if k == j { -1.0 } else { 0.0 }])
+    };
+    let row = |k: usize| {
+        let value = entry(k, 0) + entry(k, 1) + entry(k, 2);
+        Bounded {
+            value,
+            scale: value,
+        }
+        .upper()
+    };
+    let r = Vec3A::new(row(0), row(1), row(2));
+    let defect = if rotation.is_finite() {
+        r.max_element()
+    } else {
+        f32::NAN
+    };
+    if defect <= MAX_DEFECT {
+        Ok(r)
+    } else {
+        Err(FitError::NotOrthonormal { defect })
     }
 }
 
-/// The box of least volume, then least surface (for flat sets, whose volumes tie at 0).
-fn smallest(boxes: impl IntoIterator<Item = Obb3>) -> Obb3 {
+/// Half-extents `h'` that hold under both readings, from slab half-extents `h` and row
+/// bounds `r` of `E = RᵀR − I` ([`orthonormality_defect`], `n = max_k r_k <= 2^-10`).
+///
+/// A point with `s = Rᵀ(p − c)`, `|s_k| <= h_k`, is `p = c + R·u` with `u = (I + E)⁻¹ s`
+/// (`R` is invertible as `n < 1`). From `u = s − E·u`: `‖u‖∞ <= ‖s‖∞ + n·‖u‖∞`, so
+/// `‖u‖∞ <= H/(1 − n)` with `H = max_j h_j`, and `|u_k| <= h_k + r_k·H/(1 − n)`. That sum
+/// rounds 4 times (`1 − n`, the quotient, the product with `r_k`, the sum), all terms
+/// positive, so within `γ(4)` of it relative: the lemma with `scale = 0` rounds it up. A row
+/// with `r_k = 0` keeps `h_k` as it is.
+fn widened(h: Vec3A, r: Vec3A) -> Vec3A {
+    let reach = f64::from(h.max_element()) / (1.0 - f64::from(r.max_element()));
+    Vec3A::from_array([0, 1, 2].map(|k| {
+        if r[k] == 0.0 {
+            return h[k];
+        }
+        Bounded {
+            value: f64::from(h[k]) + f64::from(r[k]) * reach,
+            scale: 0.0,
+        }
+        .upper()
+    }))
+}
+
+/// The box of least volume, then least surface (for flat sets, whose volumes tie at 0),
+/// among the candidates that exist; [`FitError::Overflow`] when none does (every box that
+/// is refused overflows: the coordinate axes are always among the candidates).
+fn smallest(boxes: impl IntoIterator<Item = Result<Obb3, FitError>>) -> Result<Obb3, FitError> {
+    // Finite half-extents of `f32`: the keys are finite in `f64`.
     let key = |b: &Obb3| {
         let h = b.half_extents.as_dvec3();
         (h.element_product(), h.x * h.y + h.y * h.z + h.z * h.x)
     };
     boxes
         .into_iter()
+        .filter_map(Result::ok)
         .min_by(|a, b| {
-            key(a)
-                .partial_cmp(&key(b))
-                .unwrap_or(core::cmp::Ordering::Equal)
+            let (ka, kb) = (key(a), key(b));
+            ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
         })
-        .unwrap_or(Obb3 {
-            center: Vec3A::ZERO,
-            half_extents: Vec3A::ZERO,
-            rotation: Mat3A::IDENTITY,
-        })
+        .ok_or(FitError::Overflow)
 }
 
 /// The PCA baseline: eigenvectors of the covariance of the distinct points, centered on
 /// their mean, half-extents the largest `|projection|` about it.
-fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     let distinct = cloud::unique(points);
     let mean = cloud::mean(&distinct);
     let axes = principal_axes(cloud::covariance(&distinct, mean));
@@ -237,7 +322,7 @@ fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
 
 /// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
 /// points as given) and the best DiTO frame.
-fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     let pca = principal_axes(cloud::covariance(points, cloud::mean(points)));
     let extremal = cloud::extremal_points(points, &DITO_DIRECTIONS);
     let dito = dito_frames(&extremal)
@@ -424,7 +509,7 @@ fn refine(frame: DMat3, points: &[DVec3]) -> DMat3 {
 }
 
 /// The tight fit: the smallest midrange box over the refined hull frames and the fast fit.
-fn fit_tight(points: &[Vec3], bounds: &Aabb3) -> Obb3 {
+fn fit_tight(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     let distinct = cloud::unique(points);
     let exact_points: Vec<DVec3> = distinct.iter().map(|&p| exact(p)).collect();
     let tight = tight_frames(&exact_points).frames.into_iter().map(|f| {

@@ -1,7 +1,7 @@
 //! Bounding spheres and their fits.
 
 use super::ball::smallest_ball;
-use super::bound::{Bounded, segment_distance};
+use super::bound::{Bounded, largest, segment_distance};
 use super::cloud::{self, DIRECTIONS, exact};
 use super::{Fit, FitError};
 use crate::Aabb3;
@@ -30,27 +30,31 @@ impl Sphere {
     /// enclosing ball. The radius is then certified from every point.
     ///
     /// # Errors
-    /// [`FitError`] for no points or a non-finite point.
+    /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,
+    /// [`FitError::Overflow`] when the radius would overflow `f32`.
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
-        cloud::validate(points)?;
+        let bounds = cloud::validate(points)?;
         let center = match fit {
             Fit::Pca => cloud::mean(&cloud::unique(points)),
             Fit::Fast => fast_center(points),
             Fit::Tight => smallest_center(points),
         };
-        Ok(Self::around(points, center))
+        Self::around(points, &bounds, center)
     }
 
-    /// The sphere around `points` centered at `center` rounded to `f32`: the radius is the
-    /// largest certified distance ([`segment_distance`] with `a = b`), so every point is in.
-    fn around(points: &[Vec3], center: DVec3) -> Self {
-        let center = center.as_vec3a();
+    /// The sphere around `points` centered at `center`, moved into their bounding box
+    /// `bounds` and rounded to `f32` (so finite): the radius is the largest certified
+    /// distance ([`segment_distance`] with `a = b`), so every point is in.
+    fn around(points: &[Vec3], bounds: &Aabb3, center: DVec3) -> Result<Self, FitError> {
+        let center = cloud::round_within(center, bounds);
         let c = center.as_dvec3();
-        let radius = points
-            .iter()
-            .map(|&p| segment_distance(exact(p), c, c).upper())
-            .fold(0.0, f32::max);
-        Self { center, radius }
+        let radius = largest(
+            points
+                .iter()
+                .map(|&p| segment_distance(exact(p), c, c).upper()),
+        )
+        .ok_or(FitError::Overflow)?;
+        Ok(Self { center, radius })
     }
 
     /// True when `p` may lie in the ball: never false for a point of the ball, true only
