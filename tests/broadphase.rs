@@ -161,6 +161,19 @@ fn fat_box_growth_is_the_documented_margin() {
     assert!(b2.min.x <= -1.0 && b2.max.y >= 2.0 && b2.max.y < 2.0001);
 }
 
+#[test]
+fn fattened_refuses_the_margins_update_refuses() {
+    let b = Aabb3::new(Vec3A::new(0.0, -2.0, 10.0), Vec3A::new(4.0, 2.0, 10.0));
+    let b2 = Aabb2::new(Vec2::ZERO, Vec2::ONE);
+    for bad in [-1.0, -f32::MIN_POSITIVE, f32::INFINITY, f32::NAN] {
+        for margin in [Margin::new(bad, 0.0), Margin::new(0.0, bad)] {
+            // A negative margin would shrink the box below the tight one, silently.
+            assert!(!b.fattened(margin).is_valid(), "{margin:?}");
+            assert!(!b2.fattened(margin).is_valid(), "{margin:?}");
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // The update against a brute-force reference.
 
