@@ -12,12 +12,11 @@ use bvkit::{
     Rigid2, Rigid3, Rounding, Soa, Swept,
 };
 use glam::{Affine3A, DAffine3, DMat3, DVec3, Quat, Vec2, Vec3A};
-use num_bigint::BigInt;
 use rand::RngExt;
 use rand::rngs::StdRng;
 
 use cases::{Class, Scale, problem, quat_problem, rng};
-use oracle::{Exact, Exactly, Expected, Problem, QuatProblem, SCALE, affine3};
+use oracle::{Exact, Exactly, Expected, Problem, QuatProblem, affine3};
 
 const METHODS: [Method; 3] = [Method::Naive, Method::AbsMatrix, Method::SignSelect];
 const ROUNDINGS: [Rounding; 2] = [Rounding::Nearest, Rounding::Outward];
@@ -41,33 +40,6 @@ fn growth(margin: Margin, min: f32, max: f32) -> f32 {
     } else {
         margin.absolute
     }
-}
-
-/// An exact `f64` value (its exponent must be at least `-SCALE`).
-fn exact_f64(x: f64) -> Exact {
-    assert!(x.is_finite());
-    if x == 0.0 {
-        return Exact::ZERO;
-    }
-    let bits = x.to_bits();
-    let biased = ((bits >> 52) & 0x7ff) as i32;
-    let fraction = (bits & ((1 << 52) - 1)) as i64;
-    let (s, e) = if biased == 0 {
-        (fraction, -1074)
-    } else {
-        (fraction | 1 << 52, biased - 1075)
-    };
-    assert!(e + SCALE >= 0, "{x} is below the oracle's scale");
-    let s = if x < 0.0 { -s } else { s };
-    Exact::Finite(BigInt::from(s) << (e + SCALE) as usize)
-}
-
-/// The exact product of an `f64` and an `f32`.
-fn exact_product(m: f64, x: f32) -> Exact {
-    let Exact::Finite(a) = exact_f64(m) else {
-        unreachable!()
-    };
-    Exact::Finite(a).mul_f32(x)
 }
 
 /// `face <= exact` (a lower face) or `face >= exact`, decided exactly.
@@ -159,6 +131,19 @@ fn fat_box_growth_is_the_documented_margin() {
     }
     let b2 = Aabb2::new(Vec2::ZERO, Vec2::ONE).fattened(Margin::new(1.0, 0.0));
     assert!(b2.min.x <= -1.0 && b2.max.y >= 2.0 && b2.max.y < 2.0001);
+}
+
+#[test]
+fn fattened_refuses_the_margins_update_refuses() {
+    let b = Aabb3::new(Vec3A::new(0.0, -2.0, 10.0), Vec3A::new(4.0, 2.0, 10.0));
+    let b2 = Aabb2::new(Vec2::ZERO, Vec2::ONE);
+    for bad in [-1.0, -f32::MIN_POSITIVE, f32::INFINITY, f32::NAN] {
+        for margin in [Margin::new(bad, 0.0), Margin::new(0.0, bad)] {
+            // A negative margin would shrink the box below the tight one, silently.
+            assert!(!b.fattened(margin).is_valid(), "{margin:?}");
+            assert!(!b2.fattened(margin).is_valid(), "{margin:?}");
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -634,7 +619,7 @@ fn exact_relative(
     let mut hi: [Exact; 3] = core::array::from_fn(|_| Exact::NegInf);
     for c in local.corners() {
         for i in 0..3 {
-            let mut v = exact_f64(t[i]).add(&exact_f64(origin[i]).neg());
+            let mut v = Exact::of_f64(t[i]).add(&Exact::of_f64(origin[i]).neg());
             for j in 0..3 {
                 v = v.add(&match &cols[j][i] {
                     Exact::Finite(_) => cols[j][i].mul_f32(c[j]),
@@ -750,9 +735,9 @@ fn exact_affine(m: DMat3, local: &Aabb3, t: DVec3, origin: DVec3) -> [[Exact; 3]
     let mut hi: [Exact; 3] = core::array::from_fn(|_| Exact::NegInf);
     for c in local.corners() {
         for i in 0..3 {
-            let mut v = exact_f64(t[i]).add(&exact_f64(origin[i]).neg());
+            let mut v = Exact::of_f64(t[i]).add(&Exact::of_f64(origin[i]).neg());
             for j in 0..3 {
-                v = v.add(&exact_product(m.col(j)[i], c[j]));
+                v = v.add(&Exact::product_f64(m.col(j)[i], c[j]));
             }
             if v < lo[i] {
                 lo[i] = v.clone();

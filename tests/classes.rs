@@ -623,6 +623,161 @@ fn bad_lengths_are_refused_and_leave_the_output_untouched() {
     }
 }
 
+/// Every way to make `soa` ragged: each of its `columns` in turn one shorter and one longer.
+fn ragged<S: Clone>(soa: &S, columns: fn(&mut S) -> &mut [Vec<f32>]) -> Vec<S> {
+    let mut soa = soa.clone();
+    let mut all = Vec::new();
+    for c in 0..columns(&mut soa).len() {
+        for longer in [false, true] {
+            let mut r = soa.clone();
+            if longer {
+                columns(&mut r)[c].push(0.0);
+            } else {
+                columns(&mut r)[c].pop();
+            }
+            all.push(r);
+        }
+    }
+    all
+}
+
+#[test]
+fn ragged_soa_is_refused_with_nothing_written() {
+    use bvkit::broadphase::Swept;
+    use bvkit::{Active, BoundingVolume, Margin, Moved, Sphere};
+    // 21 values: two whole lane blocks and a tail, so that a late index panic would come
+    // after earlier blocks were written.
+    let n = 21;
+    let local = vec![Aabb3::new(Vec3A::ZERO, Vec3A::ONE); n];
+    let poses: Vec<Rigid3> = (0..n)
+        .map(|k| Rigid3 {
+            translation: Vec3A::splat(k as f32),
+            ..Rigid3::IDENTITY
+        })
+        .collect();
+    let (lsoa, xsoa) = (Soa::from_slice(&local), Soa::from_slice(&poses));
+    let sentinel = Aabb3::new(Vec3A::splat(7.0), Vec3A::splat(8.0));
+    let refused = |r: Result<(), BatchError>, what: &str| {
+        assert!(
+            matches!(r, Err(BatchError::LengthMismatch { .. })),
+            "{what}: {r:?}"
+        );
+    };
+    for backend in Backend::supported() {
+        for batch in [
+            Batch::new(Method::SignSelect, Rounding::Outward)
+                .on(backend)
+                .unwrap(),
+            Batch::new(Method::AbsMatrix, Rounding::Nearest)
+                .on(backend)
+                .unwrap()
+                .deterministic(),
+        ] {
+            let what = format!("{backend:?}");
+            let fresh = || Soa::filled(n, sentinel);
+            // Ragged transforms, through transform, update and both sides of Swept.
+            for x in ragged(&xsoa, |s| s.columns.as_mut()) {
+                let mut out = fresh();
+                refused(batch.transform(&lsoa, &x, &mut out), &what);
+                refused(
+                    batch.transform(lsoa.view(), x.view(), out.view_mut()),
+                    &what,
+                );
+                let mut aos = vec![sentinel; n];
+                refused(batch.transform(&local, &x, &mut aos[..]), &what);
+                let mut moved = Moved::new();
+                let margin = Margin::new(0.1, 0.0);
+                refused(
+                    batch.update(margin, Active::All, &lsoa, &x, &mut out, &mut moved),
+                    &what,
+                );
+                let swept = Swept {
+                    current: &xsoa,
+                    predicted: &x,
+                };
+                refused(
+                    batch.update(margin, Active::All, &lsoa, swept, &mut out, &mut moved),
+                    &what,
+                );
+                let swept = Swept {
+                    current: &x,
+                    predicted: &xsoa,
+                };
+                refused(
+                    batch.update(
+                        margin,
+                        Active::All,
+                        &local[..],
+                        swept,
+                        &mut aos[..],
+                        &mut moved,
+                    ),
+                    &what,
+                );
+                assert!(
+                    out == fresh() && aos.iter().all(|b| *b == sentinel),
+                    "{what}: written"
+                );
+                assert!(moved.is_empty(), "{what}: moved written");
+            }
+            // Ragged boxes and ragged outputs.
+            let update = |l: &Soa<Aabb3>, out: &mut Soa<Aabb3>| {
+                let margin = Margin::new(0.1, 0.0);
+                batch.update(margin, Active::All, l, &xsoa, out, &mut Moved::new())
+            };
+            for l in ragged(&lsoa, |s| s.columns.as_mut()) {
+                let mut out = fresh();
+                refused(batch.transform(&l, &xsoa, &mut out), &what);
+                refused(update(&l, &mut out), &what);
+                assert!(out == fresh(), "{what}: written");
+            }
+            for mut out in ragged(&fresh(), |s| s.columns.as_mut()) {
+                let before = out.clone();
+                refused(batch.transform(&lsoa, &xsoa, &mut out), &what);
+                refused(update(&lsoa, &mut out), &what);
+                assert!(out == before, "{what}: written");
+            }
+        }
+    }
+    // The fitted volumes' batch entry point reads transforms in the same layouts.
+    let spheres = vec![
+        Sphere {
+            center: Vec3A::ZERO,
+            radius: 1.0
+        };
+        n
+    ];
+    for x in ragged(&xsoa, |s| s.columns.as_mut()) {
+        let mut out = vec![sentinel; n];
+        refused(
+            Sphere::transformed_aabbs(&spheres, &x, &mut out, Rounding::Outward),
+            "volumes",
+        );
+        assert!(out.iter().all(|b| *b == sentinel), "volumes: written");
+    }
+}
+
+// Out-of-range indices panic as documented, with a message that names the container.
+#[test]
+#[should_panic(expected = "Block8 index 8 out of range")]
+fn block8_get_out_of_range_says_so() {
+    let _ = Block8::splat(Aabb3::EMPTY).get(8);
+}
+
+#[test]
+#[should_panic(expected = "Block8 index 9 out of range")]
+fn block8_set_out_of_range_says_so() {
+    Block8::splat(Rigid3::IDENTITY).set(9, Rigid3::IDENTITY);
+}
+
+#[test]
+#[should_panic(expected = "Soa index 2 out of range: column 0 has 2 values")]
+fn soa_get_on_a_short_column_says_so() {
+    let mut soa = Soa::from_slice(&[Aabb3::EMPTY; 3]);
+    soa.columns[0].pop();
+    let _ = soa.get(2);
+}
+
 #[test]
 fn backends_are_detected_and_forced() {
     let supported = Backend::supported();

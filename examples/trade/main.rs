@@ -1,4 +1,5 @@
 //! The speed/accuracy trade of every kernel, measured: `cargo run --release --example trade`.
+//! With `--quick` it runs on small sizes with few runs, to check that it runs (CI).
 //!
 //! For every transform class (3D translation, rigid, similarity, TRS and affine; 2D
 //! translation, rigid and affine), every method × rounding × layout (single box, AoS, SoA,

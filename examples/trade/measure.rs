@@ -18,16 +18,31 @@ use crate::oracle::{Bound, Exactly, Problem, affine2, affine3, check, rigid2};
 
 /// The seed of every random sample: the accuracy columns are identical run to run.
 pub const SEED: u64 = 0xb0c5_2026;
+/// True with `--quick`: small sizes and few runs, to check that the report runs (CI); its
+/// timings mean nothing.
+pub fn quick() -> bool {
+    std::env::args().any(|a| a == "--quick")
+}
 /// Boxes of the in-cache batch (inputs and outputs fit in L2).
-pub const CACHE: usize = 4096;
+pub fn cache() -> usize {
+    if quick() { 256 } else { 4096 }
+}
 /// Timed runs of the in-cache batch; the median is reported.
-pub const CACHE_RUNS: usize = 301;
+pub fn cache_runs() -> usize {
+    if quick() { 3 } else { 301 }
+}
 /// Boxes of the DRAM batch.
-pub const DRAM: usize = 1 << 22;
+pub fn dram() -> usize {
+    if quick() { 1 << 12 } else { 1 << 22 }
+}
 /// Timed runs of the DRAM batch; the median is reported.
-pub const DRAM_RUNS: usize = 3;
+pub fn dram_runs() -> usize {
+    if quick() { 1 } else { 3 }
+}
 /// Oracle cases per extreme class.
-pub const CASES: u64 = 1500;
+pub fn cases() -> u64 {
+    if quick() { 20 } else { 1500 }
+}
 /// The finite extreme classes the accuracy columns are measured over.
 pub const ACCURACY_CLASSES: [cases::Class; 9] = [
     cases::Class::Typical,
@@ -404,15 +419,15 @@ fn ns_per_box(n: usize, runs: usize, mut run: impl FnMut()) -> f64 {
     samples[runs / 2]
 }
 
-/// Times `run(n)` at the in-cache and the DRAM size.
+/// Times `run(n)` at the in-cache and the dram() size.
 fn times(mut run: impl FnMut(usize)) -> (f64, f64) {
     (
-        ns_per_box(CACHE, CACHE_RUNS, || run(CACHE)),
-        ns_per_box(DRAM, DRAM_RUNS, || run(DRAM)),
+        ns_per_box(cache(), cache_runs(), || run(cache())),
+        ns_per_box(dram(), dram_runs(), || run(dram())),
     )
 }
 
-/// The seeded oracle sample: [`CASES`] problems of each of the [`ACCURACY_CLASSES`].
+/// The seeded oracle sample: [`cases`] problems of each of the [`ACCURACY_CLASSES`].
 fn sample<P>(
     salt: u64,
     make: impl Fn(cases::Class, &mut rand::rngs::StdRng) -> P,
@@ -420,7 +435,7 @@ fn sample<P>(
     let mut out = Vec::new();
     for class in ACCURACY_CLASSES {
         let r = &mut rng(SEED ^ (class as u64) << 40 ^ salt);
-        out.extend((0..CASES).map(|_| (class, make(class, r))));
+        out.extend((0..cases()).map(|_| (class, make(class, r))));
     }
     out
 }
@@ -466,17 +481,17 @@ pub const AFFINE3_STAGES: usize = 2 + Method::ALL.len() * Rounding::ALL.len();
 /// (parry3d on the rigid poses of the scene, the glam loops) and the rooflines.
 pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     progress.stage("3D affine: scene and oracle sample");
-    let (boxes, xfs, poses) = common::scene(DRAM, 0x3d);
+    let (boxes, xfs, poses) = common::scene(dram(), 0x3d);
     let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));
     let (bs, xs) = (AabbSoa::from_slice(&boxes), Affine3Soa::from_slice(&xfs));
     let (cb, cx) = (
-        AabbSoa::from_slice(&boxes[..CACHE]),
-        Affine3Soa::from_slice(&xfs[..CACHE]),
+        AabbSoa::from_slice(&boxes[..cache()]),
+        Affine3Soa::from_slice(&xfs[..cache()]),
     );
-    let mut out = vec![Aabb3::EMPTY; DRAM];
+    let mut out = vec![Aabb3::EMPTY; dram()];
     let mut o8 = vec![Aabb3x8::default(); b8.len()];
-    let mut os = AabbSoa::filled(DRAM, Aabb3::EMPTY);
-    let mut co = AabbSoa::filled(CACHE, Aabb3::EMPTY);
+    let mut os = AabbSoa::filled(dram(), Aabb3::EMPTY);
+    let mut co = AabbSoa::filled(cache(), Aabb3::EMPTY);
     let sample = sample::<Problem<3>>(0, problem);
     let (sb, sx): (Vec<Aabb3>, Vec<Affine3A>) = sample.iter().map(|(_, p)| affine3(p)).unzip();
     let (ssb, ssx) = (AabbSoa::from_slice(&sb), Affine3Soa::from_slice(&sx));
@@ -522,10 +537,10 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     });
     m.roofline(Layout::Aosoa, t);
     let t = (
-        ns_per_box(CACHE, CACHE_RUNS, || {
+        ns_per_box(cache(), cache_runs(), || {
             common::roofline_soa(black_box(&cb), black_box(&cx), &mut co)
         }),
-        ns_per_box(DRAM, DRAM_RUNS, || {
+        ns_per_box(dram(), dram_runs(), || {
             common::roofline_soa(black_box(&bs), black_box(&xs), &mut os)
         }),
     );
@@ -596,12 +611,12 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
             m.kernel(k, Layout::Aos, name, t, accuracy(&sample, &results, bound));
 
             let t = (
-                ns_per_box(CACHE, CACHE_RUNS, || {
+                ns_per_box(cache(), cache_runs(), || {
                     batch
                         .transform(black_box(cb.view()), cx.view(), co.view_mut())
                         .unwrap()
                 }),
-                ns_per_box(DRAM, DRAM_RUNS, || {
+                ns_per_box(dram(), dram_runs(), || {
                     batch
                         .transform(black_box(bs.view()), xs.view(), os.view_mut())
                         .unwrap()
@@ -712,7 +727,7 @@ pub const CLASSES3_STAGES: usize = 2 + 4 * (1 + Method::ALL.len() * Rounding::AL
 /// peers on its rigid poses.
 pub fn classes3(best: Backend, progress: &Progress) -> Vec<Row> {
     progress.stage("3D classes: scene and oracle samples");
-    let s = common::class_scene(DRAM, 0xc1a55);
+    let s = common::class_scene(dram(), 0xc1a55);
     let quats = |scale| sample(0x51, |class, r| quat_problem(class, scale, r));
     let translations = sample::<Problem<3>>(0, translation_problem::<3>);
     let rigid = quats(Scale::Unit);
@@ -744,7 +759,7 @@ pub fn classes3(best: Backend, progress: &Progress) -> Vec<Row> {
     progress.stage("3D rigid: peers");
     let (pb, pp) = common::parry_scene(&s.boxes, &s.poses);
     let mut op = pb.clone();
-    let mut out = vec![Aabb3::EMPTY; DRAM];
+    let mut out = vec![Aabb3::EMPTY; dram()];
     let t = times(|n| {
         common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
     });
@@ -801,7 +816,7 @@ pub const CLASSES2_STAGES: usize = 1 + Method::ALL.len() * Rounding::ALL.len();
 /// (single, and AoS on each backend).
 pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     progress.stage("2D: scene and oracle samples");
-    let (boxes3, _, poses) = common::scene(DRAM, 0x2d);
+    let (boxes3, _, poses) = common::scene(dram(), 0x2d);
     let boxes: Vec<Aabb2> = boxes3
         .iter()
         .map(|b| Aabb2::new(b.min.truncate(), b.max.truncate()))
@@ -823,7 +838,7 @@ pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     let (ab, ax): (Vec<Aabb2>, Vec<Affine2>) =
         affine_sample.iter().map(|(_, p)| affine2(p)).unzip();
     let (rb, rx): (Vec<Aabb2>, Vec<Rigid2>) = rigid_sample.iter().map(|(_, p)| rigid2(p)).unzip();
-    let mut out = vec![Aabb2::EMPTY; DRAM];
+    let mut out = vec![Aabb2::EMPTY; dram()];
     let mut o = vec![Aabb2::EMPTY; rb.len()];
     let mut mt = Meter::new(TransformClass::Translation2, progress);
     let mut mr = Meter::new(TransformClass::Rigid2, progress);
@@ -931,5 +946,5 @@ pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
 
 /// The samples' case count, for the report.
 pub fn cases_per_kernel() -> u64 {
-    CASES * ACCURACY_CLASSES.len() as u64
+    cases() * ACCURACY_CLASSES.len() as u64
 }

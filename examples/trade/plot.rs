@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use bvkit::{Method, Rounding};
 
-use crate::measure::{CACHE, Kind, Peer, Row, SCALAR, TransformClass};
+use crate::measure::{Kind, Peer, Row, SCALAR, TransformClass, cache};
 
 /// Panels per row.
 const COLUMNS: usize = 2;
@@ -703,7 +703,8 @@ pub fn svg(rows: &[Row], best: &str) -> (String, usize) {
         "start",
         "",
         &format!(
-            "x: ns per box over {CACHE} boxes in cache (median; {best} and scalar backends, log scale). y: worst face error against the exact oracle, in u·S (log scale)."
+            "x: ns per box over {} boxes in cache (median; {best} and scalar backends, log scale). y: worst face error against the exact oracle, in u·S (log scale).",
+            cache()
         ),
     );
     legend(&mut s, 24.0, 76.0);

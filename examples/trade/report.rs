@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use bvkit::{Backend, Method, Rounding};
 
 use crate::measure::{
-    ACCURACY_CLASSES, CACHE, CACHE_RUNS, CASES, DRAM, DRAM_RUNS, Kind, Layout, Peer, Row, SCALAR,
-    TransformClass, cases_per_kernel,
+    ACCURACY_CLASSES, Kind, Layout, Peer, Row, SCALAR, TransformClass, cache, cache_runs, cases,
+    cases_per_kernel, dram, dram_runs,
 };
 
 /// "A few ulps is fine": the worst error, in `u·S`, a Nearest kernel may have to be
@@ -109,7 +109,7 @@ pub fn which_kernel(rows: &[Row], best: Backend) -> String {
             "\n### {} — `{}`\n\n| need | kernel | call | local, poses | ns/box in cache | ns/box, {} | worst error (u·S) | contains exact |\n|---|---|---|---|---:|---:|---:|---:|",
             class.profile(),
             class.pose_type(),
-            boxes(DRAM)
+            boxes(dram())
         )
         .unwrap();
         for (need, row) in [
@@ -141,7 +141,7 @@ pub fn which_kernel(rows: &[Row], best: Backend) -> String {
 pub fn summary(rows: &[Row]) -> String {
     let mut s = format!(
         "## Summary\n\nThe fastest kernel in cache per class, rounding and layout (any backend): method, ns/box in cache / at {}, worst error. Every kernel, peer and roofline is in the CSV.\n\n| class | rounding |",
-        boxes(DRAM)
+        boxes(dram())
     );
     for layout in Layout::ALL {
         write!(s, " {} |", layout.name()).unwrap();
@@ -210,7 +210,7 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
         (
             format!(
                 "abs-matrix nearest AoSoA / memory roofline, {}",
-                boxes(DRAM)
+                boxes(dram())
             ),
             nearest(Affine3)
                 .zip(roofline(Affine3))
@@ -218,21 +218,21 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
             "<= 1.15x",
         ),
         (
-            format!("affine AoSoA / rigid AoSoA, {}", boxes(DRAM)),
+            format!("affine AoSoA / rigid AoSoA, {}", boxes(dram())),
             nearest(Affine3)
                 .zip(nearest(Rigid3))
                 .map(|(a, r)| format!("{:.2}x", a.ns_dram / r.ns_dram)),
             ">= 1.25x",
         ),
         (
-            format!("rigid AoSoA / its roofline, {}", boxes(DRAM)),
+            format!("rigid AoSoA / its roofline, {}", boxes(dram())),
             nearest(Rigid3)
                 .zip(roofline(Rigid3))
                 .map(|(n, r)| format!("{:.2}x", n.ns_dram / r.ns_dram)),
             "<= 1.15x",
         ),
         (
-            format!("affine AoSoA / translation AoSoA, {}", boxes(DRAM)),
+            format!("affine AoSoA / translation AoSoA, {}", boxes(dram())),
             nearest(Affine3)
                 .zip(nearest(Translation3))
                 .map(|(a, t)| format!("{:.2}x", a.ns_dram / t.ns_dram)),
@@ -260,12 +260,13 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
 /// How the figures were measured.
 pub fn method(best: Backend, rows: &[Row]) -> String {
     let (kernels, peers, rooflines) = counts(rows);
+    let (cache_runs, dram_runs, cases) = (cache_runs(), dram_runs(), cases());
     format!(
-        "## How this was measured\n\nCPU: {}. Figures differ by vendor: subnormal operands cost an Intel core a microcode assist and an AMD core nothing, and bvkit's kernels form none on normal-range input. Best backend: {best:?} (of {:?}); the 3D affine, 2D rigid and 2D affine batch kernels also run on the scalar backend. ns/box: the median of {CACHE_RUNS} runs over {} (inputs and outputs in cache) and of {DRAM_RUNS} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({CASES} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured (the plot draws it as a dashed line at its speed, in the 3D rigid panel). The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
+        "## How this was measured\n\nCPU: {}. Figures differ by vendor: subnormal operands cost an Intel core a microcode assist and an AMD core nothing, and bvkit's kernels form none on normal-range input. Best backend: {best:?} (of {:?}); the 3D affine, 2D rigid and 2D affine batch kernels also run on the scalar backend. ns/box: the median of {cache_runs} runs over {} (inputs and outputs in cache) and of {dram_runs} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({cases} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured (the plot draws it as a dashed line at its speed, in the 3D rigid panel). The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
         crate::common::cpu(),
         Backend::supported(),
-        boxes(CACHE),
-        boxes(DRAM),
+        boxes(cache()),
+        boxes(dram()),
         cases_per_kernel(),
     )
 }

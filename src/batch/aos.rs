@@ -102,8 +102,8 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     type Class = T;
-    fn len(&self) -> Option<usize> {
-        Some(<[T]>::len(self))
+    fn len(&self) -> Result<Option<usize>, BatchError> {
+        Ok(Some(<[T]>::len(self)))
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
@@ -123,8 +123,8 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
 /// One transform shared by every box (compound bodies, instanced props).
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
     type Class = T;
-    fn len(&self) -> Option<usize> {
-        None
+    fn len(&self) -> Result<Option<usize>, BatchError> {
+        Ok(None)
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, _: usize, _: usize) -> T::Lanes<L> {
@@ -203,7 +203,7 @@ impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
 
 impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
     type Class = E;
-    fn len(&self) -> Option<usize> {
+    fn len(&self) -> Result<Option<usize>, BatchError> {
         ReadMaps::len(&self.as_slice())
     }
     #[inline(always)]

@@ -110,9 +110,16 @@ impl<T: Fields> Block8<T> {
     }
 
     /// Value `k` of the block.
+    ///
+    /// # Panics
+    /// When `k >= 8`, as a slice index does.
     #[inline]
     #[must_use]
     pub fn get(&self, k: usize) -> T {
+        assert!(
+            k < 8,
+            "Block8 index {k} out of range: a block holds 8 values"
+        );
         let mut v = [0.0; MAX_FIELDS];
         for (x, field) in v.iter_mut().zip(self.fields.as_ref()) {
             *x = field[k];
@@ -129,8 +136,15 @@ impl<T: Fields> Block8<T> {
     }
 
     /// Sets value `k` of the block.
+    ///
+    /// # Panics
+    /// When `k >= 8`, as a slice index does.
     #[inline]
     pub fn set(&mut self, k: usize, value: T) {
+        assert!(
+            k < 8,
+            "Block8 index {k} out of range: a block holds 8 values"
+        );
         let v = value.to_fields();
         for (field, x) in self.fields.as_mut().iter_mut().zip(v) {
             field[k] = x;
@@ -293,8 +307,8 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     type Class = T;
-    fn len(&self) -> Option<usize> {
-        Some(<[Block8<T>]>::len(self) * 8)
+    fn len(&self) -> Result<Option<usize>, BatchError> {
+        Ok(Some(<[Block8<T>]>::len(self) * 8))
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
@@ -372,7 +386,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
     type Class = T;
-    fn len(&self) -> Option<usize> {
+    fn len(&self) -> Result<Option<usize>, BatchError> {
         ReadMaps::len(&self.as_slice())
     }
     #[inline(always)]

@@ -182,8 +182,9 @@ pub(crate) mod sealed {
     pub trait ReadMaps<const N: usize> {
         /// The transform class.
         type Class: Class<N>;
-        /// The number of transforms, `None` for one shared transform.
-        fn len(&self) -> Option<usize>;
+        /// The number of transforms, `None` for one shared transform, or an error when
+        /// the layout's columns disagree.
+        fn len(&self) -> Result<Option<usize>, BatchError>;
         /// Transforms `i..i + count` as lanes; lanes past `count` are zero.
         fn load<L: LaneArray>(&self, i: usize, count: usize)
         -> <Self::Class as Class<N>>::Lanes<L>;
@@ -445,7 +446,7 @@ fn checked_len<const N: usize>(
         expected: len,
         found,
     };
-    if let Some(n) = xf.len().filter(|&n| n != len) {
+    if let Some(n) = xf.len()?.filter(|&n| n != len) {
         return Err(mismatch("transforms", n));
     }
     let out_len = out.len()?;

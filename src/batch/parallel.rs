@@ -42,8 +42,8 @@ impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
 
 impl<const N: usize, S: ReadMaps<N>> ReadMaps<N> for Window<'_, S> {
     type Class = S::Class;
-    fn len(&self) -> Option<usize> {
-        self.src.len().map(|_| self.len)
+    fn len(&self) -> Result<Option<usize>, BatchError> {
+        Ok(self.src.len()?.map(|_| self.len))
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> <S::Class as Class<N>>::Lanes<L> {

@@ -131,10 +131,19 @@ impl<T: Fields> Soa<T> {
     }
 
     /// Value `k`.
+    ///
+    /// # Panics
+    /// When `k` is out of range of any column (`k >= len()`, or the columns are ragged and
+    /// one is shorter), as a slice index does.
     #[must_use]
     pub fn get(&self, k: usize) -> T {
         let mut v = [0.0; MAX_FIELDS];
-        for (x, column) in v.iter_mut().zip(self.columns.as_ref()) {
+        for (n, (x, column)) in v.iter_mut().zip(self.columns.as_ref()).enumerate() {
+            assert!(
+                k < column.len(),
+                "Soa index {k} out of range: column {n} has {} values",
+                column.len()
+            );
             *x = column[k];
         }
         T::from_fields(&v)
@@ -325,17 +334,12 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
     type Class = T;
-    fn len(&self) -> Option<usize> {
-        // A transform column of another length is reported as that length.
-        let columns = self.columns.as_ref();
-        let first = columns.first().map_or(0, |c| c.len());
-        Some(
-            columns
-                .iter()
-                .map(|c| c.len())
-                .find(|&n| n != first)
-                .unwrap_or(first),
+    fn len(&self) -> Result<Option<usize>, BatchError> {
+        common_len(
+            "a column of the transforms",
+            self.columns.as_ref().iter().map(|c| c.len()),
         )
+        .map(Some)
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
@@ -420,7 +424,7 @@ where
     SoaRef<'a, E>: ReadMaps<N>,
 {
     type Class = <SoaRef<'a, E> as ReadMaps<N>>::Class;
-    fn len(&self) -> Option<usize> {
+    fn len(&self) -> Result<Option<usize>, BatchError> {
         ReadMaps::len(&self.view())
     }
     #[inline(always)]

@@ -115,9 +115,14 @@ pub(crate) fn inside_aabb3(tight: &Aabb3, fat: &Aabb3) -> bool {
 impl Aabb3 {
     /// The fat box of this tight box: grown by `margin` on every axis and rounded outward,
     /// so that it contains the exact grown box (see [`Batch::update`](crate::Batch::update)).
+    /// A margin that [`Batch::update`](crate::Batch::update) refuses (a field negative,
+    /// infinite or NaN) gives [`Aabb3::NAN`], whose `is_valid()` is false.
     #[inline]
     #[must_use]
     pub fn fattened(&self, margin: Margin) -> Aabb3 {
+        if margin.check().is_err() {
+            return Aabb3::NAN;
+        }
         // On `Vec3A` lanes: per axis the same operations, so the same bits, as in any lanes.
         let (min, max) = margin.grow::<Vec3A, 1>(Vector([self.min]), Vector([self.max]));
         Aabb3::new(min.0[0], max.0[0])
@@ -126,8 +131,12 @@ impl Aabb3 {
 
 impl Aabb2 {
     /// The fat box of this tight box: grown by `margin` on every axis and rounded outward.
+    /// A margin that [`Batch::update`](crate::Batch::update) refuses gives [`Aabb2::NAN`].
     #[must_use]
     pub fn fattened(&self, margin: Margin) -> Aabb2 {
+        if margin.check().is_err() {
+            return Aabb2::NAN;
+        }
         let (min, max) =
             margin.grow::<f32, 2>(Vector(self.min.to_array()), Vector(self.max.to_array()));
         Aabb2::new(min.0.into(), max.0.into())

@@ -68,11 +68,9 @@ impl LargePose for LargeRigid3 {
 impl LargePose for DAffine3 {
     /// The matrix is rounded to `f32`, `M = M_f + Δ` with `Δ` exact in `f64`; the box
     /// through `M_f` comes from the Outward kernel and is widened by
-    /// `w_i >= Σ_j |Δ_ij|·max(|lo_j|, |hi_j|)`, which bounds `Δ·x` for every `x` of the box.
-    /// Each `|Δ_ij|·m_j` is exact in `f64` (`Δ` has at most 29 significant bits and `m_j`
-    /// 24), the sum of three is rounded twice, and `w` is rounded up to `f32` after a
-    /// factor `1 + 2^-50`. A term with `Δ_ij = 0` is 0 even where `m_j` is infinite; a
-    /// matrix entry beyond `f32::MAX` gives the whole space.
+    /// `w_i >= Σ_j |Δ_ij|·max(|lo_j|, |hi_j|)`, which bounds `Δ·x` for every `x` of the box
+    /// (the proof is beside `residual`). A matrix entry beyond `f32::MAX` gives the whole
+    /// space.
     fn relative_aabb(&self, local: &Aabb3, origin: DVec3, method: Method) -> Aabb3 {
         let m = self.matrix3;
         if !local.is_valid() || !m.is_finite() {
@@ -90,22 +88,33 @@ impl LargePose for DAffine3 {
         let rounded = Affine3A::from_mat3(linear);
         let box_f = local.transformed(&rounded, method, Rounding::Outward);
         let reach = local.min.abs().max(local.max.abs()).as_dvec3();
-        let residual = |i: usize| -> f64 {
-            (0..3)
-                .map(|j| {
-                    let delta = m.col(j)[i] - f64::from(linear.col(j)[i]);
-                    if delta == 0.0 {
-                        0.0
-                    } else {
-                        delta.abs() * reach[j]
-                    }
-                })
-                .sum::<f64>()
-                * (1.0 + pow2(-50))
-        };
+        let residual = |i: usize| residual(m.row(i), linear.row(i).as_dvec3(), reach);
         let widen = DVec3::new(residual(0), residual(1), residual(2));
         offset(box_f, self.translation, origin, widen)
     }
+}
+
+/// An upper bound of `Σ_j |Δ_j|·r_j`, `Δ = row − rounded` (exact in `f64`: `rounded` is
+/// `row` rounded to `f32`), for `r >= 0`.
+///
+/// A term with `Δ_j = 0` or `r_j = 0` is exactly 0, even where the other factor is infinite.
+/// Otherwise the product is rounded to nearest: with a normal result its relative error is
+/// at most `2^-53`, but it may underflow (a `Δ_j` below the `f32` range, times a tiny
+/// `r_j`) and lose everything, so each term is at least `f64::MIN_POSITIVE`, which exceeds
+/// any product that rounds below it. The sum of three normal terms is rounded twice, so
+/// `(1 + 2^-53)^3 < 1 + 2^-50` covers the three roundings.
+fn residual(row: DVec3, rounded: DVec3, r: DVec3) -> f64 {
+    (0..3)
+        .map(|j| {
+            let delta = row[j] - rounded[j];
+            if delta == 0.0 || r[j] == 0.0 {
+                0.0
+            } else {
+                (delta.abs() * r[j]).max(f64::MIN_POSITIVE)
+            }
+        })
+        .sum::<f64>()
+        * (1.0 + pow2(-50))
 }
 
 /// `b + (t − origin)` widened by `widen` on every face, rounded outward: every step exact
@@ -199,6 +208,22 @@ mod tests {
         assert_eq!(add_down(f32::MAX, f32::MAX), f32::MAX);
         assert_eq!(add_up(f32::MAX, f32::MAX), f32::INFINITY);
         assert_eq!(add_down(f32::NEG_INFINITY, 1.0), f32::NEG_INFINITY);
+    }
+
+    #[test]
+    fn residual_bounds_a_product_that_underflows() {
+        // Δ = 1e-300 (the entry rounds to 0 in `f32`) times r = 2^-149: the product is
+        // below the `f64` range, but it is not 0.
+        let tiny = DVec3::new(1e-300, 0.0, 0.0);
+        let r = DVec3::splat(f64::from(f32::from_bits(1)));
+        let w = residual(tiny, DVec3::ZERO, r);
+        assert!(w > 0.0 && round_up(w) > 0.0, "{w}");
+        // An exact entry or a zero reach adds nothing, even beside an infinity.
+        let r = DVec3::new(f64::INFINITY, 0.0, 1.0);
+        assert_eq!(
+            residual(DVec3::new(1.0, 1e-300, 2.0), DVec3::new(1.0, 0.0, 2.0), r),
+            0.0
+        );
     }
 
     #[test]

@@ -151,7 +151,7 @@ use sealed::Poses;
 
 impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
-        match self.len() {
+        match self.len()? {
             Some(found) if found != len => Err(BatchError::LengthMismatch {
                 what: "poses",
                 expected: len,
@@ -334,7 +334,9 @@ impl Batch {
                 found: fat_len,
             });
         }
-        if len > u32::MAX as usize + 1 {
+        // Indices 0..len must fit in u32; compared in u64, since `u32::MAX + 1` overflows a
+        // 32-bit usize.
+        if len as u64 > u64::from(u32::MAX) + 1 {
             return Err(BatchError::TooManyObjects(len));
         }
         check_active(active, len)?;

@@ -210,7 +210,7 @@ pub trait BoundingVolume: Shape + Sized {
             expected,
             found,
         };
-        if let Some(found) = xf.len().filter(|&n| n != expected) {
+        if let Some(found) = xf.len()?.filter(|&n| n != expected) {
             return Err(mismatch("transforms", found));
         }
         if out.len() != expected {

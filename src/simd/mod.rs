@@ -25,7 +25,7 @@ pub enum Backend {
     Baseline,
     /// Lane arrays of 8 compiled for AVX2 with FMA, chosen at run time (x86-64).
     Avx2,
-    /// Lane arrays of 16 compiled for AVX-512F with FMA, chosen at run time (x86-64).
+    /// Lane arrays of 16 compiled for AVX-512F, AVX2 and FMA, chosen at run time (x86-64).
     Avx512,
     /// `wide::f32x8`: its instructions fixed at compile time by the build's target
     /// features (two SSE halves on a default x86-64 build, AVX with `target-cpu=native`).
@@ -47,24 +47,16 @@ impl Backend {
     /// the instructions.
     #[must_use]
     pub fn is_supported(self) -> bool {
+        self.features().iter().all(|&f| has_feature(f))
+    }
+
+    /// The CPU features this backend's code is compiled with (the `#[target_feature]` set
+    /// of its dispatch wrapper): the CPU must have every one of them.
+    pub(crate) const fn features(self) -> &'static [&'static str] {
         match self {
-            Backend::Scalar | Backend::Baseline | Backend::Wide => true,
-            #[cfg(all(target_arch = "x86_64", feature = "std"))]
-            Backend::Avx2 => {
-                std::arch::is_x86_feature_detected!("avx2")
-                    && std::arch::is_x86_feature_detected!("fma")
-            }
-            #[cfg(all(target_arch = "x86_64", feature = "std"))]
-            Backend::Avx512 => {
-                std::arch::is_x86_feature_detected!("avx512f")
-                    && std::arch::is_x86_feature_detected!("fma")
-            }
-            #[cfg(all(target_arch = "x86_64", not(feature = "std")))]
-            Backend::Avx2 => cfg!(all(target_feature = "avx2", target_feature = "fma")),
-            #[cfg(all(target_arch = "x86_64", not(feature = "std")))]
-            Backend::Avx512 => cfg!(all(target_feature = "avx512f", target_feature = "fma")),
-            #[cfg(not(target_arch = "x86_64"))]
-            Backend::Avx2 | Backend::Avx512 => false,
+            Backend::Scalar | Backend::Baseline | Backend::Wide => &[],
+            Backend::Avx2 => &["avx2", "fma"],
+            Backend::Avx512 => &["avx512f", "avx2", "fma"],
         }
     }
 
@@ -124,6 +116,30 @@ impl Backend {
     }
 }
 
+/// True when the running CPU has `feature` (one of [`Backend::features`]): detected at run
+/// time with the `std` feature, and without it only when the build guarantees it.
+fn has_feature(feature: &str) -> bool {
+    #[cfg(all(target_arch = "x86_64", feature = "std"))]
+    return match feature {
+        "avx2" => std::arch::is_x86_feature_detected!("avx2"),
+        "avx512f" => std::arch::is_x86_feature_detected!("avx512f"),
+        "fma" => std::arch::is_x86_feature_detected!("fma"),
+        _ => false,
+    };
+    #[cfg(all(target_arch = "x86_64", not(feature = "std")))]
+    return match feature {
+        "avx2" => cfg!(target_feature = "avx2"),
+        "avx512f" => cfg!(target_feature = "avx512f"),
+        "fma" => cfg!(target_feature = "fma"),
+        _ => false,
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = feature;
+        false
+    }
+}
+
 /// A batch job, written once over a lane type.
 pub(crate) trait Job {
     /// Runs the job with lanes `L`; implementations are `#[inline(always)]` so that they
@@ -146,14 +162,15 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
         (Backend::Baseline, _) | (Backend::Wide, false) => job.run::<F32s<8, false>>(),
         (Backend::Wide, true) => job.run::<wide::f32x8>(),
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has AVX2 and FMA.
+        // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has every
+        // feature of `Backend::Avx2.features()`, the set `run_avx2` enables.
         (Backend::Avx2, true) => unsafe { run_avx2::<J, F32s<8, true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         (Backend::Avx2, false) => unsafe { run_avx2::<J, F32s<8, false>>(job) },
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has
-        // AVX-512F and FMA.
+        // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has every
+        // feature of `Backend::Avx512.features()`, the set `run_avx512` enables.
         (Backend::Avx512, true) => unsafe { run_avx512::<J, F32s<16, true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
@@ -163,12 +180,14 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     }
 }
 
+// The features enabled here are `Backend::Avx2.features()` (a test checks they agree).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn run_avx2<J: Job, L: LaneArray>(job: J) {
     job.run::<L>();
 }
 
+// The features enabled here are `Backend::Avx512.features()` (a test checks they agree).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
 fn run_avx512<J: Job, L: LaneArray>(job: J) {
@@ -204,4 +223,32 @@ pub(crate) fn prefetch<T>(x: &T) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = x;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each dispatch wrapper enables exactly the features its backend checks for: a
+    /// backend enabled on a CPU that lacks one of them would run illegal instructions.
+    #[test]
+    fn backends_check_every_feature_their_code_enables() {
+        let source = include_str!("mod.rs");
+        for (backend, wrapper) in [(Backend::Avx2, "run_avx2"), (Backend::Avx512, "run_avx512")] {
+            let at = source
+                .find(&alloc::format!("fn {wrapper}<"))
+                .expect("the wrapper");
+            let attribute = "#[target_feature(enable = \"";
+            let start = source[..at].rfind(attribute).expect("its attribute") + attribute.len();
+            let enabled = source[start..].split('"').next().unwrap_or_default();
+            let mut enabled: Vec<&str> = enabled.split(',').collect();
+            let mut checked = backend.features().to_vec();
+            enabled.sort_unstable();
+            checked.sort_unstable();
+            assert_eq!(enabled, checked, "{backend:?}");
+        }
+        for backend in [Backend::Scalar, Backend::Baseline, Backend::Wide] {
+            assert!(backend.features().is_empty() && backend.is_supported());
+        }
+    }
 }

@@ -81,6 +81,30 @@ impl Exact {
         Exact::Finite((BigInt::from(sm) * BigInt::from(sx)) << (em + ex + SCALE) as usize)
     }
 
+    /// The exact value of a finite `f64` (its exponent must be at least `-SCALE`).
+    pub fn of_f64(x: f64) -> Exact {
+        assert!(x.is_finite());
+        if x == 0.0 {
+            return Exact::ZERO;
+        }
+        let bits = x.to_bits();
+        let biased = ((bits >> 52) & 0x7ff) as i32;
+        let fraction = (bits & ((1 << 52) - 1)) as i64;
+        let (s, e) = if biased == 0 {
+            (fraction, -1074)
+        } else {
+            (fraction | 1 << 52, biased - 1075)
+        };
+        assert!(e + SCALE >= 0, "{x} is below the oracle's scale");
+        let s = if x < 0.0 { -s } else { s };
+        Exact::Finite(BigInt::from(s) << (e + SCALE) as usize)
+    }
+
+    /// The exact product of a finite `f64` and an `f32`, with `0 · ±inf = 0`.
+    pub fn product_f64(m: f64, x: f32) -> Exact {
+        Exact::of_f64(m).mul_f32(x)
+    }
+
     /// The exact sum; `+inf + -inf` has no value and is an oracle misuse.
     pub fn add(&self, other: &Exact) -> Exact {
         match (self, other) {
