@@ -528,7 +528,9 @@ impl Bound {
 /// What one checked result measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Measured {
-    /// The largest face error in units of `u·S` (`S` floored at one subnormal ulp).
+    /// The largest face error in units of `u·S`, `S` floored at `TINY_PAD / u`: the pads'
+    /// documented absolute part sets the faces of boxes at the origin, and a floor below
+    /// it (one subnormal ulp, once) measured that term as `2^49·u·S` there.
     pub worst_error_us: f64,
     /// True when the result contains the exact box.
     pub contains: bool,
@@ -680,7 +682,7 @@ fn check_certified_f64<const N: usize>(
             if gap.abs() + error > allowance {
                 return None;
             }
-            let unit = U * magnitude + f64::from(f32::from_bits(1));
+            let unit = U * magnitude + f64::from(TINY_PAD);
             measured.worst_error_us = measured.worst_error_us.max(gap.abs() / unit);
         }
         exact_volume *= hi - lo;
