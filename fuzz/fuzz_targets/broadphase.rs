@@ -107,49 +107,68 @@ struct Cx {
     valid: bool,
 }
 
-/// Runs the update in `cx.layout` with the poses `$poses` (any source), for boxes of type
-/// `$B`: a macro, since the layouts' element bound is sealed.
+/// Runs the update with the boxes in layout `$l` (0: AoS, 1: AoSoA, 2: SoA), or in
+/// `cx.layout`, and the poses `$poses` (any source): a macro, since the layouts' element
+/// bound is sealed.
 macro_rules! update_in {
-    ($cx:expr, $local:expr, $poses:expr, $fat:expr, $moved:expr) => {{
+    (@0, $cx:expr, $local:expr, $poses:expr, $fat:expr, $moved:expr) => {{
         let (cx, local, fat, moved): (&Cx, &[_], &mut Vec<_>, &mut Moved) =
             ($cx, $local, $fat, $moved);
         let (b, m, a) = (&cx.batch, cx.margin, cx.set.active());
-        match cx.layout {
-            0 => b.update(m, a, local, $poses, &mut fat[..], moved),
-            1 => {
-                let (l, mut f) = (Block8::pack(local), Block8::pack(fat));
-                let r = b.update(m, a, &l[..], $poses, &mut f[..], moved);
-                *fat = Block8::unpack(&f, fat.len());
-                r
-            }
-            _ => {
-                let (l, mut f) = (Soa::from_slice(local), Soa::from_slice(fat));
-                let r = b.update(m, a, &l, $poses, &mut f, moved);
-                *fat = (0..fat.len()).map(|k| f.get(k)).collect();
-                r
-            }
+        b.update(m, a, local, $poses, &mut fat[..], moved)
+    }};
+    (@1, $cx:expr, $local:expr, $poses:expr, $fat:expr, $moved:expr) => {{
+        let (cx, local, fat, moved): (&Cx, &[_], &mut Vec<_>, &mut Moved) =
+            ($cx, $local, $fat, $moved);
+        let (b, m, a) = (&cx.batch, cx.margin, cx.set.active());
+        let (l, mut f) = (Block8::pack(local), Block8::pack(fat));
+        let r = b.update(m, a, &l[..], $poses, &mut f[..], moved);
+        *fat = Block8::unpack(&f, fat.len());
+        r
+    }};
+    (@2, $cx:expr, $local:expr, $poses:expr, $fat:expr, $moved:expr) => {{
+        let (cx, local, fat, moved): (&Cx, &[_], &mut Vec<_>, &mut Moved) =
+            ($cx, $local, $fat, $moved);
+        let (b, m, a) = (&cx.batch, cx.margin, cx.set.active());
+        let (l, mut f) = (Soa::from_slice(local), Soa::from_slice(fat));
+        let r = b.update(m, a, &l, $poses, &mut f, moved);
+        *fat = (0..fat.len()).map(|k| f.get(k)).collect();
+        r
+    }};
+    ($cx:expr, $local:expr, $poses:expr, $fat:expr, $moved:expr) => {{
+        match $cx.layout {
+            0 => update_in!(@0, $cx, $local, $poses, $fat, $moved),
+            1 => update_in!(@1, $cx, $local, $poses, $fat, $moved),
+            _ => update_in!(@2, $cx, $local, $poses, $fat, $moved),
         }
     }};
 }
 
-/// `$body` with `$p` bound to the transforms `$xs` in `cx.layout`.
-macro_rules! in_layout {
-    ($layout:expr, $xs:expr, |$p:ident| $body:expr) => {{
-        let xs = $xs;
-        match $layout {
-            0 => {
-                let $p = &xs[..];
-                $body
-            }
+/// The three stages of a class with the boxes and both pose sets in `cx.layout` (one
+/// layout for all, as a scene stores them: a layout per input multiplied the update's
+/// instantiations, and the release build of this target ran past half an hour), each
+/// stage's update plain or swept.
+macro_rules! class_stages {
+    (@$l:tt, $cx:expr, $local:expr, $a:expr, $b:expr, $swept:expr, $fat0:expr, $faces:expr, $expect:expr) => {{
+        let (cx, a, b) = ($cx, $a, $b);
+        let mut update = |stage: usize, fat: &mut Vec<_>, moved: &mut Moved| match ($swept, stage) {
+            (true, _) => update_in!(@$l, cx, $local, Swept { current: a, predicted: b }, fat, moved),
+            (false, 2) => update_in!(@$l, cx, $local, b, fat, moved),
+            _ => update_in!(@$l, cx, $local, a, fat, moved),
+        };
+        stages(cx, $fat0, $faces, &mut update, $expect)
+    }};
+    ($cx:expr, $local:expr, $now:expr, $next:expr, $swept:expr, $fat0:expr, $faces:expr, $expect:expr) => {{
+        let (cx, now, next) = ($cx, $now, $next);
+        match cx.layout {
+            0 => class_stages!(@0, cx, $local, &now[..], &next[..], $swept, $fat0, $faces, $expect),
             1 => {
-                let packed = Block8::pack(xs);
-                let $p = &packed[..];
-                $body
+                let (a, b) = (Block8::pack(now), Block8::pack(next));
+                class_stages!(@1, cx, $local, &a[..], &b[..], $swept, $fat0, $faces, $expect)
             }
             _ => {
-                let soa = Soa::from_slice(xs);
-                let $p = &soa;
-                $body
+                let (a, b) = (Soa::from_slice(now), Soa::from_slice(next));
+                class_stages!(@2, cx, $local, &a, &b, $swept, $fat0, $faces, $expect)
             }
         }
     }};
@@ -283,28 +302,7 @@ fn class3<T: Transform3, P: Exactly<3>>(
         (false, 2) => vec![qs[i].expected()],
         _ => vec![ps[i].expected()],
     };
-    in_layout!(cx.layout, &now[..], |a| in_layout!(
-        cx.layout,
-        &next[..],
-        |b| {
-            let mut update =
-                |stage: usize, fat: &mut Vec<Aabb3>, moved: &mut Moved| match (swept, stage) {
-                    (true, _) => update_in!(
-                        cx,
-                        &local,
-                        Swept {
-                            current: a,
-                            predicted: b
-                        },
-                        fat,
-                        moved
-                    ),
-                    (false, 2) => update_in!(cx, &local, b, fat, moved),
-                    _ => update_in!(cx, &local, a, fat, moved),
-                };
-            stages(cx, fat0.clone(), faces3, &mut update, &expect)
-        }
-    ))
+    class_stages!(cx, &local, &now, &next, swept, fat0, faces3, &expect)
 }
 
 /// One 2D class, as [`class3`].
@@ -335,28 +333,7 @@ fn class2<T: Transform2>(
         (false, 2) => vec![qs[i].0.expected()],
         _ => vec![ps[i].0.expected()],
     };
-    in_layout!(cx.layout, &now[..], |a| in_layout!(
-        cx.layout,
-        &next[..],
-        |b| {
-            let mut update =
-                |stage: usize, fat: &mut Vec<Aabb2>, moved: &mut Moved| match (swept, stage) {
-                    (true, _) => update_in!(
-                        cx,
-                        &local,
-                        Swept {
-                            current: a,
-                            predicted: b
-                        },
-                        fat,
-                        moved
-                    ),
-                    (false, 2) => update_in!(cx, &local, b, fat, moved),
-                    _ => update_in!(cx, &local, a, fat, moved),
-                };
-            stages(cx, fat0.clone(), faces2, &mut update, &expect)
-        }
-    ))
+    class_stages!(cx, &local, &now, &next, swept, fat0, faces2, &expect)
 }
 
 /// An `f64` from a fuzzed `f32`, scaled by a power of two (within the oracle's range).
