@@ -435,8 +435,8 @@ impl<T: Transform3> AosUpdateOn<'_, T> {
             margin,
             ..
         } = self.update;
-        // Method calls rather than closures: a closure here was compiled out of line, and
-        // the method and rounding with it, which then ran the update at half the speed.
+        // Method calls rather than closures: a closure here was compiled out of line, with
+        // the method and rounding as run-time values instead of constants.
         let job = Chunk {
             local,
             maps: self.maps,

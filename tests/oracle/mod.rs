@@ -525,6 +525,11 @@ impl Bound {
     }
 }
 
+/// The unit of [`Measured::worst_error_us`]: `u·S`, `S` floored at `TINY_PAD / u`.
+fn error_unit(magnitude: f64) -> f64 {
+    U * magnitude + f64::from(TINY_PAD)
+}
+
 /// What one checked result measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Measured {
@@ -596,8 +601,7 @@ fn check_face(
             exact.to_f64()
         ));
     }
-    let unit = U * magnitude + f64::from(f32::from_bits(1));
-    Ok((error / unit, contains))
+    Ok((error / error_unit(magnitude), contains))
 }
 
 /// Checks a result against the contract and measures it.
@@ -682,7 +686,7 @@ fn check_certified_f64<const N: usize>(
             if gap.abs() + error > allowance {
                 return None;
             }
-            let unit = U * magnitude + f64::from(TINY_PAD);
+            let unit = error_unit(magnitude);
             measured.worst_error_us = measured.worst_error_us.max(gap.abs() / unit);
         }
         exact_volume *= hi - lo;
