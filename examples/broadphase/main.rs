@@ -1,81 +1,62 @@
-//! The per-frame broadphase update on a random walk: N bodies (default 1M) move for T
-//! frames (default 30), a fraction of them asleep (default 0.5), in islands of 256
-//! consecutive bodies that sleep together (as engines put a resting pile to sleep; a
-//! fourth argument sets the island size, 1 for bodies asleep one by one at random). Each
-//! frame prints the
-//! update's cost, the fraction of awake bodies whose fat box moved and the fat boxes
-//! rewritten, next to the naive path that recomputes and rewrites every box every frame.
+//! The broadphase on a seeded random walk of N bodies (default 1M) over T frames (default
+//! 30), a fraction of them asleep (default 0.5) in islands of 256 consecutive bodies that
+//! sleep together (as engines put a resting pile to sleep; a fourth argument sets the island
+//! size, 1 for bodies asleep one by one at random). Two modes:
 //!
-//! `cargo run --release --example broadphase [N] [T] [asleep] [island]`
-//!
-//! After every frame it checks what the update promises in each layout: every fat box
-//! contains its body's tight box.
+//! - `cargo run --release --example broadphase [N] [T] [asleep] [island]`: the fat-box
+//!   update against the naive path that recomputes and rewrites every box every frame, in
+//!   AoS and AoSoA; each frame prints the update's cost, the fraction of awake bodies whose
+//!   fat box moved and the fat boxes rewritten. After every frame it checks what the update
+//!   promises in each layout: every fat box contains its body's tight box.
+//! - `cargo run --release --example broadphase bvh [N] [T] [asleep] [island]`: two whole
+//!   broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage by stage.
+
+mod bvh;
+mod scene;
 
 use std::time::Instant;
 
-use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3, Rigid3x8, Rounding};
-use glam::{Quat, Vec3A};
-use rand::rngs::StdRng;
-use rand::{RngExt, SeedableRng};
+use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3x8, Rounding};
+
+use scene::Scene;
 
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let mut arg = |default: f64| {
-        args.next()
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let pipelines = args.first().is_some_and(|a| a == "bvh");
+    if pipelines {
+        args.remove(0);
+    }
+    let arg = |k: usize, default: f64| {
+        args.get(k)
             .map_or(default, |a| a.parse().expect("a number"))
     };
-    let n = arg(1e6) as usize;
-    let frames = arg(30.0) as usize;
-    let asleep = arg(0.5);
-    let island = (arg(256.0) as usize).max(1);
-    let mut r = StdRng::seed_from_u64(0xb0d1e5);
-
-    // Bodies: boxes of 0.2 to 2 units in a 1 km cube, a random velocity of up to 2 m/s,
-    // a random spin; `asleep` of the islands never move (their bits are clear in the mask).
-    let local: Vec<Aabb3> = (0..n)
-        .map(|_| {
-            let e = Vec3A::new(
-                r.random_range(0.1..1.0),
-                r.random_range(0.1..1.0),
-                r.random_range(0.1..1.0),
-            );
-            Aabb3::new(-e, e)
-        })
-        .collect();
-    let mut poses: Vec<Rigid3> = (0..n)
-        .map(|_| {
-            let axis = Vec3A::new(r.random(), r.random(), r.random()).normalize_or(Vec3A::Y);
-            let rotation = Quat::from_axis_angle(axis.into(), r.random_range(0.0..6.3));
-            let position = Vec3A::new(
-                r.random_range(-500.0..500.0),
-                r.random_range(-500.0..500.0),
-                r.random_range(-500.0..500.0),
-            );
-            Rigid3::new(rotation, position)
-        })
-        .collect();
-    let velocity: Vec<Vec3A> = (0..n)
-        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 4.0 - 2.0)
-        .collect();
-    let spin = Quat::from_rotation_y(0.02);
-    let mut mask = vec![0u64; n.div_ceil(64)];
-    let mut awake = 0;
-    for start in (0..n).step_by(island) {
-        if r.random::<f64>() >= asleep {
-            for i in start..(start + island).min(n) {
-                mask[i / 64] |= 1 << (i % 64);
-                awake += 1;
-            }
-        }
+    let (n, frames, asleep) = (arg(0, 1e6) as usize, arg(1, 30.0) as usize, arg(2, 0.5));
+    let island = (arg(3, 256.0) as usize).max(1);
+    if pipelines {
+        bvh::run(n, frames, asleep, island);
+    } else {
+        update_against_naive(n, frames, asleep, island);
     }
+}
 
+/// The fat-box update against the naive pass, in AoS and AoSoA.
+fn update_against_naive(n: usize, frames: usize, asleep: f64, island: usize) {
+    let mut scene = Scene::new(n, asleep, island);
+    let (awake, mask, local) = (scene.awake, scene.mask.clone(), scene.local.clone());
     let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
     let margin = Margin::new(0.05, 0.1);
     let mut fat = vec![Aabb3::EMPTY; n];
     let mut world = vec![Aabb3::EMPTY; n];
     let mut moved = Moved::new();
     batch
-        .update(margin, Active::All, &local, &poses, &mut fat, &mut moved)
+        .update(
+            margin,
+            Active::All,
+            &local,
+            &scene.poses,
+            &mut fat,
+            &mut moved,
+        )
         .expect("lengths agree");
     // The same scene in AoSoA blocks (the mask's length counts the padded blocks), its fat
     // boxes from its own first update.
@@ -85,7 +66,7 @@ fn main() {
     let mut mask8 = mask.clone();
     mask8.resize((8 * local8.len()).div_ceil(64), 0);
     let mut moved8 = Moved::new();
-    let poses8 = Rigid3x8::pack(&poses);
+    let poses8 = Rigid3x8::pack(&scene.poses);
     batch
         .update(
             margin,
@@ -118,26 +99,16 @@ fn main() {
     );
     let (mut total_update, mut total_naive, mut total_moved) = (0.0, 0.0, 0);
     let (mut total_update8, mut total_naive8) = (0.0, 0.0);
-    let dt = 1.0 / 60.0;
     for frame in 0..frames {
-        // The simulation step: awake bodies move and spin.
-        for (w, &word) in mask.iter().enumerate() {
-            let mut bits = word;
-            while bits != 0 {
-                let i = 64 * w + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let p = &mut poses[i];
-                p.translation += velocity[i] * dt;
-                p.rotation = spin * p.rotation;
-            }
-        }
+        scene.step();
+        let poses = &scene.poses;
         let start = Instant::now();
         batch
             .update(
                 margin,
                 Active::Mask(&mask),
                 &local,
-                &poses,
+                poses,
                 &mut fat,
                 &mut moved,
             )
@@ -145,11 +116,11 @@ fn main() {
         let update = start.elapsed().as_secs_f64();
         let start = Instant::now();
         batch
-            .transform(&local, &poses, &mut world)
+            .transform(&local, poses, &mut world)
             .expect("lengths agree");
         let naive = start.elapsed().as_secs_f64();
         // AoSoA: the poses packed outside the timing (a packed engine simulates in place).
-        let poses8 = Rigid3x8::pack(&poses);
+        let poses8 = Rigid3x8::pack(poses);
         let start = Instant::now();
         batch
             .update(

@@ -1,0 +1,323 @@
+//! Two broadphase pipelines on one scene, each on its own parry3d `Bvh`, frame by frame.
+//!
+//! - A, as rapier runs it: every awake body's world box (`Aabb::transform_by`), each into
+//!   the tree with `insert_or_update_partially(box, body, margin)` (a leaf changes only when
+//!   the box leaves its enlarged box), then `refit`, `optimize_incremental` and the new
+//!   pairs (`traverse_bvtt_single_tree::<true>`).
+//! - B, with bvkit: `Batch::update` (Outward) of the fat boxes of the awake bodies, then only
+//!   the moved ones into the tree, then the same three steps. The fat box already holds the
+//!   margin, so the tree adds none; parry marks a leaf changed only under a positive margin,
+//!   so B passes the smallest normal `f32`, which moves no face of a box farther than
+//!   `2^-126` from the origin.
+//!
+//! Both trees start from the same first frame. A leaf's box depends on when it was last
+//! rewritten, so neither pipeline's pair set contains the other's by construction; what
+//! both promise is that every pair of bodies whose world boxes overlap is a pair of
+//! overlapping leaves. On scenes of up to 20 000 bodies every frame checks that against a
+//! sweep over the bodies' Outward world boxes, which contain the exact images (A's leaves
+//! contain them too: the margin is far wider than the rounding of `transform_by`).
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rounding};
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::math::Pose;
+use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
+
+use crate::scene::Scene;
+
+/// The margin both pipelines give a box when its leaf is rewritten (B's relative part is
+/// zero, so that its fat boxes are A's enlarged boxes at the same instant).
+const MARGIN: f32 = 0.05;
+
+/// One pipeline's tree, its workspace and the pairs it found in the last frame.
+struct Tree {
+    bvh: Bvh,
+    workspace: BvhWorkspace,
+    pairs: Vec<(u32, u32)>,
+}
+
+/// The milliseconds of a frame's stages, and what they did.
+#[derive(Default, Clone, Copy)]
+struct Frame {
+    /// World or fat boxes, tree leaves, refit, optimisation, pairs.
+    ms: [f64; 5],
+    rewritten: usize,
+    pairs: usize,
+}
+
+impl Frame {
+    fn total(&self) -> f64 {
+        self.ms.iter().sum()
+    }
+}
+
+impl Tree {
+    /// A tree over `boxes` enlarged by `margin` (parry inserts a new leaf as given, and
+    /// enlarges only a box that leaves its leaf), refitted.
+    fn new(boxes: impl Iterator<Item = Aabb>, margin: f32) -> Self {
+        let mut tree = Self {
+            bvh: Bvh::new(),
+            workspace: BvhWorkspace::default(),
+            pairs: Vec::new(),
+        };
+        for (i, b) in boxes.enumerate() {
+            tree.bvh
+                .insert_or_update_partially(b.loosened(margin), i as u32, margin);
+        }
+        tree.bvh.refit(&mut tree.workspace);
+        tree
+    }
+
+    /// The three stages after the leaves: refit, optimisation, the new pairs.
+    fn finish(&mut self, frame: &mut Frame) {
+        let start = Instant::now();
+        self.bvh.refit(&mut self.workspace);
+        frame.ms[2] = ms(start);
+        let start = Instant::now();
+        self.bvh.optimize_incremental(&mut self.workspace);
+        frame.ms[3] = ms(start);
+        let start = Instant::now();
+        self.pairs.clear();
+        let pairs = &mut self.pairs;
+        self.bvh
+            .traverse_bvtt_single_tree::<true>(&mut self.workspace, &mut |a, b| {
+                pairs.push((a.min(b), a.max(b)))
+            });
+        frame.ms[4] = ms(start);
+        frame.pairs = self.pairs.len();
+    }
+
+    /// Every pair of overlapping leaves.
+    fn all_pairs(&mut self) -> HashSet<(u32, u32)> {
+        let mut all = HashSet::new();
+        self.bvh
+            .traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
+                all.insert((a.min(b), a.max(b)));
+            });
+        all
+    }
+}
+
+fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+fn parry_box(b: &Aabb3) -> Aabb {
+    Aabb::new(b.min.into(), b.max.into())
+}
+
+/// Every pair of boxes that overlap (closed boxes), by a sweep along x.
+fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
+    let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+    order.sort_by(|&a, &b| {
+        boxes[a as usize]
+            .mins
+            .x
+            .total_cmp(&boxes[b as usize].mins.x)
+    });
+    let mut pairs = HashSet::new();
+    for (k, &a) in order.iter().enumerate() {
+        let ba = &boxes[a as usize];
+        for &b in &order[k + 1..] {
+            let bb = &boxes[b as usize];
+            if bb.mins.x > ba.maxs.x {
+                break;
+            }
+            if ba.intersects(bb) {
+                pairs.insert((a.min(b), a.max(b)));
+            }
+        }
+    }
+    pairs
+}
+
+pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
+    let mut scene = Scene::new(n, asleep, island);
+    let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
+    let pose = |p: &bvkit::Rigid3| Pose::from_parts(p.translation.into(), p.rotation);
+    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+    let margin = Margin::new(MARGIN, 0.0);
+    let verify = n <= 20_000;
+
+    // The first frame: every body's box in both trees.
+    let mut poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
+    let mut world: Vec<Aabb> = local
+        .iter()
+        .zip(&poses)
+        .map(|(b, p)| b.transform_by(p))
+        .collect();
+    let mut a = Tree::new(world.iter().copied(), MARGIN);
+    let mut fat = vec![Aabb3::EMPTY; n];
+    let mut moved = Moved::new();
+    batch
+        .update(
+            margin,
+            Active::All,
+            &scene.local,
+            &scene.poses,
+            &mut fat,
+            &mut moved,
+        )
+        .expect("lengths agree");
+    let mut b = Tree::new(fat.iter().map(parry_box), f32::MIN_POSITIVE);
+
+    println!(
+        "{n} bodies, {} awake ({:.0}% asleep, in islands of {island}), margin {MARGIN}; \
+         bvkit {:?} {:?} on {:?}; CPU {}",
+        scene.awake,
+        asleep * 100.0,
+        batch.method,
+        batch.rounding,
+        batch.backend(),
+        cpu()
+    );
+    println!(
+        "{:>5} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>6} | {:>6}",
+        "frame",
+        "A boxes",
+        "leaves",
+        "refit",
+        "optim",
+        "pairs",
+        "total",
+        "rewrit",
+        "new",
+        "B update",
+        "leaves",
+        "refit",
+        "optim",
+        "pairs",
+        "total",
+        "rewrit",
+        "new",
+        "B/A"
+    );
+    let (mut sum_a, mut sum_b) = (Frame::default(), Frame::default());
+    // Over the checked frames: overlapping world boxes, and leaf pairs of one tree only.
+    let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
+    for frame in 0..frames {
+        scene.step();
+        // The engine's own pose form for A, converted outside the timing.
+        for i in scene.awake() {
+            poses[i] = pose(&scene.poses[i]);
+        }
+
+        let mut fa = Frame::default();
+        let start = Instant::now();
+        for i in scene.awake() {
+            world[i] = local[i].transform_by(&poses[i]);
+        }
+        fa.ms[0] = ms(start);
+        let start = Instant::now();
+        for i in scene.awake() {
+            let status = a.bvh.insert_or_update_partially(world[i], i as u32, MARGIN);
+            fa.rewritten += usize::from(status != BvhLeafUpdateStatus::Unchanged);
+        }
+        fa.ms[1] = ms(start);
+        a.finish(&mut fa);
+
+        let mut fb = Frame::default();
+        let start = Instant::now();
+        batch
+            .update(
+                margin,
+                Active::Mask(&scene.mask),
+                &scene.local,
+                &scene.poses,
+                &mut fat,
+                &mut moved,
+            )
+            .expect("lengths agree");
+        fb.ms[0] = ms(start);
+        let start = Instant::now();
+        for &i in moved.indices() {
+            b.bvh
+                .insert_or_update_partially(parry_box(&fat[i as usize]), i, f32::MIN_POSITIVE);
+        }
+        fb.rewritten = moved.len();
+        fb.ms[1] = ms(start);
+        b.finish(&mut fb);
+
+        if verify {
+            let mut tight = vec![Aabb3::EMPTY; n];
+            batch
+                .transform(&scene.local, &scene.poses, &mut tight)
+                .expect("lengths agree");
+            let tight: Vec<Aabb> = tight.iter().map(parry_box).collect();
+            let exact = overlapping(&tight);
+            let (all_a, all_b) = (a.all_pairs(), b.all_pairs());
+            assert!(exact.is_subset(&all_a), "A misses an overlapping pair");
+            assert!(exact.is_subset(&all_b), "B misses an overlapping pair");
+            overlaps += exact.len();
+            only_a += all_a.difference(&all_b).count();
+            only_b += all_b.difference(&all_a).count();
+        }
+        print_frame(&frame.to_string(), &fa, &fb);
+        for k in 0..5 {
+            sum_a.ms[k] += fa.ms[k];
+            sum_b.ms[k] += fb.ms[k];
+        }
+        sum_a.rewritten += fa.rewritten;
+        sum_b.rewritten += fb.rewritten;
+        sum_a.pairs += fa.pairs;
+        sum_b.pairs += fb.pairs;
+    }
+    let mean = |s: Frame| {
+        let f = frames.max(1) as f64;
+        Frame {
+            ms: s.ms.map(|x| x / f),
+            rewritten: (s.rewritten as f64 / f).round() as usize,
+            pairs: (s.pairs as f64 / f).round() as usize,
+        }
+    };
+    print_frame("mean", &mean(sum_a), &mean(sum_b));
+    if verify {
+        let f = frames.max(1) as f64;
+        println!(
+            "checked every frame: each pair of overlapping world boxes ({:.0} per frame) is a \
+             leaf pair of both trees; leaf pairs of A's tree only {:.0}, of B's only {:.0} per \
+             frame",
+            overlaps as f64 / f,
+            only_a as f64 / f,
+            only_b as f64 / f
+        );
+    }
+}
+
+fn print_frame(label: &str, a: &Frame, b: &Frame) {
+    println!(
+        "{label:>5} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8} {:>6} | {:>5.2}×",
+        a.ms[0],
+        a.ms[1],
+        a.ms[2],
+        a.ms[3],
+        a.ms[4],
+        a.total(),
+        a.rewritten,
+        a.pairs,
+        b.ms[0],
+        b.ms[1],
+        b.ms[2],
+        b.ms[3],
+        b.ms[4],
+        b.total(),
+        b.rewritten,
+        b.pairs,
+        b.total() / a.total()
+    );
+}
+
+/// The CPU the figures come from.
+fn cpu() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, name)| name.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".to_string())
+}
