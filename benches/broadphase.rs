@@ -7,8 +7,18 @@
 //! local box, the pose and the fat box, 96 bytes per active object, and writes nothing)
 //! and `moved` (every active object leaves it, alternating between two poses: 32 more
 //! bytes written, and its index). Active subsets are sorted random index lists.
+//!
+//! The `pipeline` groups run the broadphase example's two pipelines on parry3d's `Bvh`
+//! (`examples/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
+//! bodies all awake and at 1M with half asleep, stage by stage: each sample is one frame
+//! of both pipelines, of which the measured stage's time is reported.
 
+#[path = "../examples/broadphase/bvh.rs"]
+#[allow(dead_code)]
+mod bvh;
 mod common;
+#[path = "../examples/broadphase/scene.rs"]
+mod scene;
 
 use std::hint::black_box;
 
@@ -191,5 +201,45 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// The stages of a pipeline frame, as `bvh::Frame::ms` orders them, and the whole frame.
+const STAGES: [&str; 6] = ["boxes", "leaves", "optimise", "refit", "pairs", "frame"];
+
+fn pipelines(c: &mut Criterion) {
+    use criterion::SamplingMode;
+    use std::time::Duration;
+    for (n, asleep, label) in [
+        (100_000, 0.0, "100K-awake"),
+        (1_000_000, 0.5, "1M-half-asleep"),
+    ] {
+        let mut scene = scene::Scene::new(n, asleep, 256);
+        let mut pipelines = bvh::Pipelines::new(&scene);
+        let mut g = c.benchmark_group(format!("pipeline/{label}"));
+        // One frame per sample: a frame runs both pipelines whatever the stage measured,
+        // so criterion's usual iteration counts (sized to the stage) would run for hours.
+        // Criterion warns that 10 samples do not fit in the target time; that is the intent.
+        g.sampling_mode(SamplingMode::Flat)
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(1))
+            .measurement_time(Duration::from_millis(1));
+        for (who, pick) in [("A", 0), ("B", 1)] {
+            for (k, stage) in STAGES.iter().enumerate() {
+                g.bench_function(format!("{who}/{stage}"), |b| {
+                    b.iter_custom(|iters| {
+                        let mut ms = 0.0;
+                        for _ in 0..iters {
+                            scene.step();
+                            let frames = pipelines.frame(&scene);
+                            let f = [frames.0, frames.1][pick];
+                            ms += f.ms.get(k).copied().unwrap_or_else(|| f.total());
+                        }
+                        Duration::from_secs_f64(ms / 1e3)
+                    })
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench, pipelines);
 criterion_main!(benches);

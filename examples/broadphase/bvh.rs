@@ -41,15 +41,15 @@ struct Tree {
 
 /// The milliseconds of a frame's stages, and what they did.
 #[derive(Default, Clone, Copy)]
-struct Frame {
+pub struct Frame {
     /// World or fat boxes, tree leaves, optimisation, refit, pairs.
-    ms: [f64; 5],
-    rewritten: usize,
-    pairs: usize,
+    pub ms: [f64; 5],
+    pub rewritten: usize,
+    pub pairs: usize,
 }
 
 impl Frame {
-    fn total(&self) -> f64 {
+    pub fn total(&self) -> f64 {
         self.ms.iter().sum()
     }
 }
@@ -134,36 +134,118 @@ fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
     pairs
 }
 
+/// Both pipelines' state over one scene.
+pub struct Pipelines {
+    local: Vec<Aabb>,
+    /// A's poses, in parry's form (the engine's own, converted outside the timing).
+    poses: Vec<Pose>,
+    world: Vec<Aabb>,
+    a: Tree,
+    batch: Batch,
+    margin: Margin,
+    fat: Vec<Aabb3>,
+    moved: Moved,
+    b: Tree,
+}
+
+fn pose(p: &bvkit::Rigid3) -> Pose {
+    Pose::from_parts(p.translation.into(), p.rotation)
+}
+
+impl Pipelines {
+    /// Both trees over the scene's first frame: every body's box.
+    pub fn new(scene: &Scene) -> Self {
+        let n = scene.local.len();
+        let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
+        let poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
+        let world: Vec<Aabb> = local
+            .iter()
+            .zip(&poses)
+            .map(|(b, p)| b.transform_by(p))
+            .collect();
+        let a = Tree::new(world.iter().copied(), MARGIN);
+        let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+        let margin = Margin::new(MARGIN, 0.0);
+        let mut fat = vec![Aabb3::EMPTY; n];
+        let mut moved = Moved::new();
+        batch
+            .update(
+                margin,
+                Active::All,
+                &scene.local,
+                &scene.poses,
+                &mut fat,
+                &mut moved,
+            )
+            .expect("lengths agree");
+        let b = Tree::new(fat.iter().map(parry_box), f32::MIN_POSITIVE);
+        Self {
+            local,
+            poses,
+            world,
+            a,
+            batch,
+            margin,
+            fat,
+            moved,
+            b,
+        }
+    }
+
+    /// One frame of each pipeline on the scene's current poses.
+    pub fn frame(&mut self, scene: &Scene) -> (Frame, Frame) {
+        for i in scene.awake() {
+            self.poses[i] = pose(&scene.poses[i]);
+        }
+        let mut fa = Frame::default();
+        let start = Instant::now();
+        for i in scene.awake() {
+            self.world[i] = self.local[i].transform_by(&self.poses[i]);
+        }
+        fa.ms[0] = ms(start);
+        let start = Instant::now();
+        for i in scene.awake() {
+            let status = self
+                .a
+                .bvh
+                .insert_or_update_partially(self.world[i], i as u32, MARGIN);
+            fa.rewritten += usize::from(status != BvhLeafUpdateStatus::Unchanged);
+        }
+        fa.ms[1] = ms(start);
+        self.a.finish(&mut fa);
+
+        let mut fb = Frame::default();
+        let start = Instant::now();
+        self.batch
+            .update(
+                self.margin,
+                Active::Mask(&scene.mask),
+                &scene.local,
+                &scene.poses,
+                &mut self.fat,
+                &mut self.moved,
+            )
+            .expect("lengths agree");
+        fb.ms[0] = ms(start);
+        let start = Instant::now();
+        for &i in self.moved.indices() {
+            let fat = parry_box(&self.fat[i as usize]);
+            self.b
+                .bvh
+                .insert_or_update_partially(fat, i, f32::MIN_POSITIVE);
+        }
+        fb.rewritten = self.moved.len();
+        fb.ms[1] = ms(start);
+        self.b.finish(&mut fb);
+        (fa, fb)
+    }
+}
+
 pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
     let mut scene = Scene::new(n, asleep, island);
-    let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
-    let pose = |p: &bvkit::Rigid3| Pose::from_parts(p.translation.into(), p.rotation);
-    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
-    let margin = Margin::new(MARGIN, 0.0);
+    let mut pipelines = Pipelines::new(&scene);
     let verify = n <= 20_000;
-
-    // The first frame: every body's box in both trees.
-    let mut poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
-    let mut world: Vec<Aabb> = local
-        .iter()
-        .zip(&poses)
-        .map(|(b, p)| b.transform_by(p))
-        .collect();
-    let mut a = Tree::new(world.iter().copied(), MARGIN);
-    let mut fat = vec![Aabb3::EMPTY; n];
-    let mut moved = Moved::new();
-    batch
-        .update(
-            margin,
-            Active::All,
-            &scene.local,
-            &scene.poses,
-            &mut fat,
-            &mut moved,
-        )
-        .expect("lengths agree");
-    let mut b = Tree::new(fat.iter().map(parry_box), f32::MIN_POSITIVE);
-
+    let batch = pipelines.batch;
     println!(
         "{n} bodies, {} awake ({:.0}% asleep, in islands of {island}), margin {MARGIN}; \
          bvkit {:?} {:?} on {:?}; CPU {}",
@@ -200,47 +282,7 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
     let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
     for frame in 0..frames {
         scene.step();
-        // The engine's own pose form for A, converted outside the timing.
-        for i in scene.awake() {
-            poses[i] = pose(&scene.poses[i]);
-        }
-
-        let mut fa = Frame::default();
-        let start = Instant::now();
-        for i in scene.awake() {
-            world[i] = local[i].transform_by(&poses[i]);
-        }
-        fa.ms[0] = ms(start);
-        let start = Instant::now();
-        for i in scene.awake() {
-            let status = a.bvh.insert_or_update_partially(world[i], i as u32, MARGIN);
-            fa.rewritten += usize::from(status != BvhLeafUpdateStatus::Unchanged);
-        }
-        fa.ms[1] = ms(start);
-        a.finish(&mut fa);
-
-        let mut fb = Frame::default();
-        let start = Instant::now();
-        batch
-            .update(
-                margin,
-                Active::Mask(&scene.mask),
-                &scene.local,
-                &scene.poses,
-                &mut fat,
-                &mut moved,
-            )
-            .expect("lengths agree");
-        fb.ms[0] = ms(start);
-        let start = Instant::now();
-        for &i in moved.indices() {
-            b.bvh
-                .insert_or_update_partially(parry_box(&fat[i as usize]), i, f32::MIN_POSITIVE);
-        }
-        fb.rewritten = moved.len();
-        fb.ms[1] = ms(start);
-        b.finish(&mut fb);
-
+        let (fa, fb) = pipelines.frame(&scene);
         if verify {
             let mut tight = vec![Aabb3::EMPTY; n];
             batch
@@ -248,7 +290,7 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
                 .expect("lengths agree");
             let tight: Vec<Aabb> = tight.iter().map(parry_box).collect();
             let exact = overlapping(&tight);
-            let (all_a, all_b) = (a.all_pairs(), b.all_pairs());
+            let (all_a, all_b) = (pipelines.a.all_pairs(), pipelines.b.all_pairs());
             assert!(exact.is_subset(&all_a), "A misses an overlapping pair");
             assert!(exact.is_subset(&all_b), "B misses an overlapping pair");
             overlaps += exact.len();
