@@ -8,8 +8,8 @@
 //! - B, with bvkit: `Batch::update` (Outward) of the fat boxes of the awake bodies, then only
 //!   the moved ones into the tree, then the same three steps. The fat box already holds the
 //!   margin, so the tree adds none; parry marks a leaf changed only under a positive margin,
-//!   so B passes the smallest normal `f32`, which moves no face of a box farther than
-//!   `2^-126` from the origin.
+//!   so B passes the smallest normal `f32`, which moves a face by at most `2^-126` (and not
+//!   at all where `|face| >= 2^-102`).
 //!
 //! Both trees start from the same first frame. A leaf's box depends on when it was last
 //! rewritten, so neither pipeline's pair set contains the other's by construction; what
@@ -353,7 +353,7 @@ fn print_frame(label: &str, a: &Frame, b: &Frame) {
 }
 
 /// The CPU the figures come from.
-fn cpu() -> String {
+pub fn cpu() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|info| {

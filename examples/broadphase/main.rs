@@ -79,10 +79,11 @@ fn update_against_naive(n: usize, frames: usize, asleep: f64, island: usize) {
         .expect("lengths agree");
     println!(
         "{n} bodies, {awake} awake ({:.0}% asleep, in islands of {island}), margin {margin:?}, \
-         {:?} on {:?}, 60 Hz",
+         {:?} on {:?}, 60 Hz; CPU {}",
         asleep * 100.0,
         batch.method,
-        batch.backend()
+        batch.backend(),
+        bvh::cpu()
     );
     println!(
         "{:>5} | {:>9} {:>12} {:>9} {:>9} | {:>9} {:>9} | {:>10} {:>9} | {:>9}",
