@@ -26,6 +26,7 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
 
+use crate::common::cpu;
 use crate::scene::Scene;
 
 /// The margin both pipelines give a box when its leaf is rewritten (B's relative part is
@@ -256,24 +257,20 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
         batch.backend(),
         cpu()
     );
+    // The columns of each pipeline: its stages in `Frame::ms` order, then the totals.
+    let columns = |first: &str| {
+        [
+            first, "leaves", "optim", "refit", "pairs", "total", "rewrit",
+        ]
+        .map(|c| format!("{c:>8}"))
+        .join(" ")
+    };
     println!(
-        "{:>5} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>6} | {:>6}",
+        "{:>5} | {} {:>6} | {} {:>6} | {:>6}",
         "frame",
-        "A boxes",
-        "leaves",
-        "optim",
-        "refit",
-        "pairs",
-        "total",
-        "rewrit",
+        columns("A boxes"),
         "new",
-        "B update",
-        "leaves",
-        "optim",
-        "refit",
-        "pairs",
-        "total",
-        "rewrit",
+        columns("B update"),
         "new",
         "B/A"
     );
@@ -350,17 +347,4 @@ fn print_frame(label: &str, a: &Frame, b: &Frame) {
         b.pairs,
         b.total() / a.total()
     );
-}
-
-/// The CPU the figures come from.
-pub fn cpu() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|info| {
-            info.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, name)| name.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".to_string())
 }

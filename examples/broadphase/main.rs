@@ -12,6 +12,8 @@
 //!   broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage by stage.
 
 mod bvh;
+#[path = "../../benches/common/mod.rs"]
+mod common;
 mod scene;
 
 use std::time::Instant;
@@ -83,7 +85,7 @@ fn update_against_naive(n: usize, frames: usize, asleep: f64, island: usize) {
         asleep * 100.0,
         batch.method,
         batch.backend(),
-        bvh::cpu()
+        common::cpu()
     );
     println!(
         "{:>5} | {:>9} {:>12} {:>9} {:>9} | {:>9} {:>9} | {:>10} {:>9} | {:>9}",
