@@ -10,8 +10,9 @@
 //!
 //! The `pipeline` groups run the broadphase example's two pipelines on parry3d's `Bvh`
 //! (`examples/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
-//! bodies all awake and at 1M with half asleep, stage by stage: each sample is one frame
-//! of both pipelines, of which the measured stage's time is reported.
+//! bodies all awake and at 1M with half asleep, stage by stage, and B again with a relative
+//! margin of 0.3 (`--relative 0.3` in the example): each sample is one frame of both
+//! pipelines, of which the measured stage's time is reported.
 
 #[path = "../examples/broadphase/bvh.rs"]
 #[allow(dead_code)]
@@ -211,8 +212,17 @@ fn pipelines(c: &mut Criterion) {
         (100_000, 0.0, "100K-awake"),
         (1_000_000, 0.5, "1M-half-asleep"),
     ] {
-        let mut scene = scene::Scene::new(n, asleep, 256);
-        let mut pipelines = bvh::Pipelines::new(&scene);
+        // B as the issue states it (A's margin), and B with a relative margin as well, each
+        // beside its own A on its own copy of the scene.
+        let relative = bvh::Tuning {
+            relative: 0.3,
+            ..Default::default()
+        };
+        let mut runs = [bvh::Tuning::default(), relative].map(|tuning| {
+            let scene = scene::Scene::new(n, asleep, 256);
+            let pipelines = bvh::Pipelines::new(&scene, tuning);
+            (scene, pipelines)
+        });
         let mut g = c.benchmark_group(format!("pipeline/{label}"));
         // One frame per sample: a frame runs both pipelines whatever the stage measured,
         // so criterion's usual iteration counts (sized to the stage) would run for hours.
@@ -221,14 +231,15 @@ fn pipelines(c: &mut Criterion) {
             .sample_size(10)
             .warm_up_time(Duration::from_millis(1))
             .measurement_time(Duration::from_millis(1));
-        for (who, pick) in [("A", 0), ("B", 1)] {
+        for (who, tuned, pick) in [("A", 0, 0), ("B", 0, 1), ("B-relative-0.3", 1, 1)] {
             for (k, stage) in STAGES.iter().enumerate() {
                 g.bench_function(format!("{who}/{stage}"), |b| {
                     b.iter_custom(|iters| {
                         let mut ms = 0.0;
                         for _ in 0..iters {
+                            let (scene, pipelines) = &mut runs[tuned];
                             scene.step();
-                            let frames = pipelines.frame(&scene);
+                            let frames = pipelines.frame(scene);
                             let f = [frames.0, frames.1][pick];
                             ms += f.ms.get(k).copied().unwrap_or_else(|| f.total());
                         }

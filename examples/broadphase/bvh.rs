@@ -5,11 +5,22 @@
 //!   the box leaves its enlarged box), then `optimize_incremental`, `refit` (in rapier's
 //!   order: refitted before the optimisation, the tree lost pairs in `tests/pipeline.rs`)
 //!   and the new pairs (`traverse_bvtt_single_tree::<true>`).
-//! - B, with bvkit: `Batch::update` (Outward) of the fat boxes of the awake bodies, then only
+//! - B, with bvkit: `Batch::update` (Outward, AoSoA blocks) of the fat boxes of the awake bodies, then only
 //!   the moved ones into the tree, then the same three steps. The fat box already holds the
 //!   margin, so the tree adds none; parry marks a leaf changed only under a positive margin,
 //!   so B passes the smallest normal `f32`, which moves a face by at most `2^-126` (and not
 //!   at all where `|face| >= 2^-102`).
+//!
+//! Two options of B's (`Tuning`) test what bvkit can take off the tree's work:
+//! - `--relative R`: B's fat boxes also grow each face by `R` times the box's half-extent
+//!   along it (`Margin`'s relative part, which parry's absolute margin cannot express), so
+//!   fewer leaves change and the change-detection traversal visits less; the boxes are
+//!   fatter, so B reports more pairs.
+//! - `--partial K`: B optimises and refits the whole tree only every K-th frame, and in
+//!   between refits only the paths above the leaves that changed (`refit_partial`, which
+//!   parry allows only with no optimisation since the last refit), from the moved list
+//!   bvkit returns: the one stage that costs the same whatever moved becomes
+//!   `O(moved × height)`.
 //!
 //! Both trees start from the same first frame. A leaf's box depends on when it was last
 //! rewritten, so neither pipeline's pair set contains the other's by construction; what
@@ -21,7 +32,7 @@
 use std::collections::HashSet;
 use std::time::Instant;
 
-use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rounding};
+use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3x8, Rounding};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
@@ -33,11 +44,23 @@ use crate::scene::Scene;
 /// zero, so that its fat boxes are A's enlarged boxes at the same instant).
 const MARGIN: f32 = 0.05;
 
-/// One pipeline's tree, its workspace and the pairs it found in the last frame.
+/// One pipeline's tree, its workspace, the pairs it found in the last frame, and the leaves
+/// whose change flag the last refit set (every leaf after the first).
 struct Tree {
     bvh: Bvh,
     workspace: BvhWorkspace,
     pairs: Vec<(u32, u32)>,
+    changed: Vec<u32>,
+}
+
+/// What B does beyond A's pipeline (module docs); the default is A's tree work exactly.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tuning {
+    /// The relative part of B's margin.
+    pub relative: f32,
+    /// Optimise and refit the whole tree every this many frames, and refit only the changed
+    /// paths in between (0: the whole tree every frame, as A).
+    pub partial: usize,
 }
 
 /// The milliseconds of a frame's stages, and what they did.
@@ -63,22 +86,34 @@ impl Tree {
             bvh: Bvh::new(),
             workspace: BvhWorkspace::default(),
             pairs: Vec::new(),
+            changed: Vec::new(),
         };
         for (i, b) in boxes.enumerate() {
             tree.bvh
                 .insert_or_update_partially(b.loosened(margin), i as u32, margin);
+            tree.changed.push(i as u32);
         }
         tree.bvh.refit(&mut tree.workspace);
         tree
     }
 
-    /// The three stages after the leaves: optimisation, refit, the new pairs.
-    fn finish(&mut self, frame: &mut Frame) {
+    /// The three stages after the leaves, whose leaves `changed` were rewritten: the
+    /// optimisation and the refit of the whole tree, or (`whole` false) the refit of the
+    /// paths above the leaves changed in this frame and the last; then the new pairs.
+    fn finish(&mut self, whole: bool, changed: &[u32], frame: &mut Frame) {
         let start = Instant::now();
-        self.bvh.optimize_incremental(&mut self.workspace);
+        if whole {
+            self.bvh.optimize_incremental(&mut self.workspace);
+        }
         frame.ms[2] = ms(start);
         let start = Instant::now();
-        self.bvh.refit(&mut self.workspace);
+        if whole {
+            self.bvh.refit(&mut self.workspace);
+        } else {
+            self.bvh.refit_partial(&self.changed, changed);
+        }
+        self.changed.clear();
+        self.changed.extend_from_slice(changed);
         frame.ms[3] = ms(start);
         let start = Instant::now();
         self.pairs.clear();
@@ -144,9 +179,19 @@ pub struct Pipelines {
     a: Tree,
     batch: Batch,
     margin: Margin,
-    fat: Vec<Aabb3>,
+    /// B's bodies in AoSoA blocks (the update's fastest layout; an engine that keeps its
+    /// poses packed simulates in place, so the packing is outside the timing), the awake
+    /// mask padded to whole blocks, and the fat boxes.
+    local8: Vec<Aabb3x8>,
+    poses8: Vec<Rigid3x8>,
+    mask8: Vec<u64>,
+    fat: Vec<Aabb3x8>,
     moved: Moved,
     b: Tree,
+    tuning: Tuning,
+    /// Frames run, and A's rewritten leaves in this one.
+    frames: usize,
+    rewritten: Vec<u32>,
 }
 
 fn pose(p: &bvkit::Rigid3) -> Pose {
@@ -155,7 +200,7 @@ fn pose(p: &bvkit::Rigid3) -> Pose {
 
 impl Pipelines {
     /// Both trees over the scene's first frame: every body's box.
-    pub fn new(scene: &Scene) -> Self {
+    pub fn new(scene: &Scene, tuning: Tuning) -> Self {
         let n = scene.local.len();
         let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
         let poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
@@ -166,20 +211,27 @@ impl Pipelines {
             .collect();
         let a = Tree::new(world.iter().copied(), MARGIN);
         let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
-        let margin = Margin::new(MARGIN, 0.0);
-        let mut fat = vec![Aabb3::EMPTY; n];
+        let margin = Margin::new(MARGIN, tuning.relative);
+        let local8 = Aabb3x8::pack(&scene.local);
+        let poses8 = Rigid3x8::pack(&scene.poses);
+        let mut fat = Aabb3x8::pack(&vec![Aabb3::EMPTY; n]);
         let mut moved = Moved::new();
         batch
             .update(
                 margin,
                 Active::All,
-                &scene.local,
-                &scene.poses,
-                &mut fat,
+                &local8[..],
+                &poses8[..],
+                &mut fat[..],
                 &mut moved,
             )
             .expect("lengths agree");
-        let b = Tree::new(fat.iter().map(parry_box), f32::MIN_POSITIVE);
+        let b = Tree::new(
+            Aabb3x8::unpack(&fat, n).iter().map(parry_box),
+            f32::MIN_POSITIVE,
+        );
+        let mut mask8 = scene.mask.clone();
+        mask8.resize((8 * local8.len()).div_ceil(64), 0);
         Self {
             local,
             poses,
@@ -187,9 +239,15 @@ impl Pipelines {
             a,
             batch,
             margin,
+            local8,
+            poses8,
+            mask8,
             fat,
             moved,
             b,
+            tuning,
+            frames: 0,
+            rewritten: Vec::new(),
         }
     }
 
@@ -197,6 +255,7 @@ impl Pipelines {
     pub fn frame(&mut self, scene: &Scene) -> (Frame, Frame) {
         for i in scene.awake() {
             self.poses[i] = pose(&scene.poses[i]);
+            self.poses8[i / 8].set(i % 8, scene.poses[i]);
         }
         let mut fa = Frame::default();
         let start = Instant::now();
@@ -205,51 +264,59 @@ impl Pipelines {
         }
         fa.ms[0] = ms(start);
         let start = Instant::now();
+        self.rewritten.clear();
         for i in scene.awake() {
             let status = self
                 .a
                 .bvh
                 .insert_or_update_partially(self.world[i], i as u32, MARGIN);
-            fa.rewritten += usize::from(status != BvhLeafUpdateStatus::Unchanged);
+            if status != BvhLeafUpdateStatus::Unchanged {
+                self.rewritten.push(i as u32);
+            }
         }
+        fa.rewritten = self.rewritten.len();
         fa.ms[1] = ms(start);
-        self.a.finish(&mut fa);
+        self.a.finish(true, &self.rewritten, &mut fa);
 
         let mut fb = Frame::default();
         let start = Instant::now();
         self.batch
             .update(
                 self.margin,
-                Active::Mask(&scene.mask),
-                &scene.local,
-                &scene.poses,
-                &mut self.fat,
+                Active::Mask(&self.mask8),
+                &self.local8[..],
+                &self.poses8[..],
+                &mut self.fat[..],
                 &mut self.moved,
             )
             .expect("lengths agree");
         fb.ms[0] = ms(start);
         let start = Instant::now();
         for &i in self.moved.indices() {
-            let fat = parry_box(&self.fat[i as usize]);
+            let (block, lane) = (i as usize / 8, i as usize % 8);
+            let fat = parry_box(&self.fat[block].get(lane));
             self.b
                 .bvh
                 .insert_or_update_partially(fat, i, f32::MIN_POSITIVE);
         }
         fb.rewritten = self.moved.len();
         fb.ms[1] = ms(start);
-        self.b.finish(&mut fb);
+        self.frames += 1;
+        let partial = self.tuning.partial;
+        let whole = partial == 0 || self.frames.is_multiple_of(partial);
+        self.b.finish(whole, self.moved.indices(), &mut fb);
         (fa, fb)
     }
 }
 
-pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
+pub fn run(n: usize, frames: usize, asleep: f64, island: usize, tuning: Tuning) {
     let mut scene = Scene::new(n, asleep, island);
-    let mut pipelines = Pipelines::new(&scene);
+    let mut pipelines = Pipelines::new(&scene, tuning);
     let verify = n <= 20_000;
     let batch = pipelines.batch;
     println!(
         "{n} bodies, {} awake ({:.0}% asleep, in islands of {island}), margin {MARGIN}; \
-         bvkit {:?} {:?} on {:?}; CPU {}",
+         bvkit {:?} {:?} on {:?}; B's {tuning:?}; CPU {}",
         scene.awake,
         asleep * 100.0,
         batch.method,
@@ -313,6 +380,12 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize) {
         }
     };
     print_frame("mean", &mean(sum_a), &mean(sum_b));
+    // What the narrow phase inherits: every pair of overlapping leaves, new or not.
+    println!(
+        "overlapping leaf pairs after the last frame: A {}, B {}",
+        pipelines.a.all_pairs().len(),
+        pipelines.b.all_pairs().len()
+    );
     if verify {
         let f = frames.max(1) as f64;
         println!(

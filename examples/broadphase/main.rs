@@ -8,8 +8,9 @@
 //!   AoS and AoSoA; each frame prints the update's cost, the fraction of awake bodies whose
 //!   fat box moved and the fat boxes rewritten. After every frame it checks what the update
 //!   promises in each layout: every fat box contains its body's tight box.
-//! - `cargo run --release --example broadphase bvh [N] [T] [asleep] [island]`: two whole
-//!   broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage by stage.
+//! - `cargo run --release --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
+//!   [--partial K]`: two whole broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage
+//!   by stage; the options tune bvkit's pipeline.
 
 mod bvh;
 #[path = "../../benches/common/mod.rs"]
@@ -28,6 +29,17 @@ fn main() {
     if pipelines {
         args.remove(0);
     }
+    // `--name value`, taken out of the positional arguments.
+    let mut option = |name: &str| {
+        let k = args.iter().position(|a| a == name)?;
+        let value = args.get(k + 1).expect("a value after the option").clone();
+        args.drain(k..k + 2);
+        Some(value.parse::<f64>().expect("a number"))
+    };
+    let tuning = bvh::Tuning {
+        relative: option("--relative").unwrap_or(0.0) as f32,
+        partial: option("--partial").unwrap_or(0.0) as usize,
+    };
     let arg = |k: usize, default: f64| {
         args.get(k)
             .map_or(default, |a| a.parse().expect("a number"))
@@ -35,7 +47,7 @@ fn main() {
     let (n, frames, asleep) = (arg(0, 1e6) as usize, arg(1, 30.0) as usize, arg(2, 0.5));
     let island = (arg(3, 256.0) as usize).max(1);
     if pipelines {
-        bvh::run(n, frames, asleep, island);
+        bvh::run(n, frames, asleep, island, tuning);
     } else {
         update_against_naive(n, frames, asleep, island);
     }
