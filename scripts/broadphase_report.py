@@ -2,7 +2,9 @@
 """Tabulates one `cargo bench --bench broadphase` run (criterion's JSON under
 target/criterion): per active fraction, ns per active object of the update and of the
 memory roofline of the same accesses, and their ratio, for the `stay` case (no fat box
-rewritten) and the `moved` case (every active fat box rewritten); and the naive path.
+rewritten) and the `moved` case (every active fat box rewritten); the naive path; and the
+`pipeline` groups: per scene, the mean ms per frame of each stage of each pipeline, and
+each frame as a ratio to pipeline A's.
 Usage: python3 scripts/broadphase_report.py [target/criterion]
 """
 import json
@@ -11,9 +13,15 @@ import sys
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/criterion")
 rows = {}  # (fraction, name) -> (ns per active object, total ms)
+stages = {}  # (scene, pipeline, stage) -> mean ms per frame
 for bench in root.glob("**/new/benchmark.json"):
     meta = json.loads(bench.read_text())
     group = meta["group_id"]
+    if group.startswith("pipeline/"):
+        pipeline, stage = meta["function_id"].split("/")
+        mean = json.loads((bench.parent / "estimates.json").read_text())["mean"]["point_estimate"]
+        stages[(group.split("/", 1)[1], pipeline, stage)] = mean / 1e6
+        continue
     if not group.startswith("broadphase/"):
         continue
     fraction = group.split("/", 1)[1]
@@ -34,3 +42,14 @@ for fraction in ["1%", "10%", "100%"]:
 naive = rows.get(("100%", "naive/transform"))
 if naive:
     print(f"\nnaive (every tight box rewritten, 1M objects): {naive[0]:.1f} ns per object, {naive[1]:.2f} ms per frame")
+
+STAGES = ["boxes", "leaves", "optimise", "refit", "pairs", "frame"]
+if stages:
+    print("\n| scene | pipeline | " + " | ".join(STAGES) + " | frame / A's |")
+    print("|---|---|" + "---:|" * (len(STAGES) + 1))
+    for scene in sorted({k[0] for k in stages}, key=lambda s: (len(s), s)):
+        for pipeline in sorted({k[1] for k in stages if k[0] == scene}):
+            cells = [stages.get((scene, pipeline, s)) for s in STAGES]
+            a = stages.get((scene, "A", "frame"))
+            ratio = f"{cells[-1] / a:.2f}x" if a and cells[-1] else "-"
+            print(f"| {scene} | {pipeline} | " + " | ".join(f"{c:.2f}" if c is not None else "-" for c in cells) + f" | {ratio} |")

@@ -18,7 +18,7 @@
 //! # Which call to make
 //!
 //! Three choices, in this order. The figures are ns per box on one AVX2 core (the
-//! README's criterion `speed` run, 1K boxes in cache); `cargo run --release --example
+//! criterion run of `docs/speed.md`, 1K boxes in cache); `cargo run --release --example
 //! trade` measures every combination on your machine in under two minutes.
 //!
 //! ## 1. The transform class: what your poses hold
@@ -174,7 +174,11 @@ pub use transform::{
 
 pub use glam;
 
-// Every Rust block of the README is compiled and run as a doctest.
+// Every Rust block of the README and of the guide is compiled and run as a doctest.
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+#[cfg(doctest)]
+#[doc = include_str!("../docs/guide.md")]
+struct GuideDoctests;

@@ -119,7 +119,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
 
     /// Also test the 9 cross axes (in `f64`) on every pair of primitive boxes before the
     /// leaf is visited. Off by default: measured on the tori and spot scenes, it culls few
-    /// pairs and costs more than it saves (see the README's Trees section).
+    /// pairs and costs more than it saves (measured in `docs/trees.md`).
     #[must_use]
     pub fn with_cross_axes_near_leaves(mut self, on: bool) -> Self {
         self.cross_near_leaves = on;

@@ -1,0 +1,35 @@
+#!/usr/bin/env python3
+"""Tabulates one `cargo bench --bench trees` run (criterion's JSON under target/criterion):
+per scene and query, µs per query (criterion's median over an iteration of 200 poses) for
+bvkit's compact and quantized trees and for parry3d, and parry3d's time over bvkit's.
+Usage: python3 scripts/trees_report.py [target/criterion]
+"""
+import json
+import pathlib
+import sys
+
+POSES = 200  # poses per iteration, as benches/trees.rs runs them
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "target/criterion")
+rows = {}  # (scene, query, who) -> µs per query
+for bench in root.glob("**/new/benchmark.json"):
+    meta = json.loads(bench.read_text())
+    if not meta["group_id"].startswith("trees/"):
+        continue
+    scene = meta["group_id"].split("/", 1)[1]
+    query, who = meta["function_id"].split("/")
+    median = json.loads((bench.parent / "estimates.json").read_text())["median"]["point_estimate"]
+    rows[(scene, query, who)] = median / 1e3 / POSES
+
+QUERIES = {
+    "intersects": "`intersects` vs `query::intersection_test`",
+    "pairs": "`overlapping_triangles` vs `Bvh::leaf_pairs` + triangle tests",
+}
+print("| scene | query | bvkit compact | bvkit quantized | parry3d | parry3d / bvkit |")
+print("|---|---|---:|---:|---:|---:|")
+for scene in sorted({k[0] for k in rows}):
+    for query, label in QUERIES.items():
+        c, q, p = (rows.get((scene, query, w)) for w in ("bvkit", "bvkit-quantized", "parry3d"))
+        if c is None or p is None:
+            continue
+        quantized = f"{q:,.1f} µs" if q is not None else "-"
+        print(f"| {scene} | {label} | {c:,.1f} µs | {quantized} | {p:,.1f} µs | {p / c:.1f}× |")
