@@ -23,8 +23,8 @@
 //!   `O(moved × height)`.
 //!
 //! Both trees start from the same first frame, and one frame runs unmeasured before the
-//! measured ones. A leaf's box depends on when it was last
-//! rewritten, so neither pipeline's pair set contains the other's by construction; what
+//! measured ones. A leaf's box depends on when it was last rewritten, so neither
+//! pipeline's pair set contains the other's by construction; what
 //! both promise is that every pair of bodies whose world boxes overlap is a pair of
 //! overlapping leaves. On scenes of up to 20 000 bodies every frame checks that against a
 //! sweep over the bodies' Outward world boxes, which contain the exact images (A's leaves
