@@ -1,7 +1,7 @@
 //! Batch kernels at L1, L2 and DRAM sizes, per layout and backend, with peers and the memory
 //! roofline in the same run. `cargo bench --bench batch`.
 
-mod common;
+use bvkit_support::common;
 
 use std::hint::black_box;
 

@@ -14,12 +14,9 @@
 //! margin of 0.3 (`--relative 0.3` in the example): each sample is one frame of both
 //! pipelines, of which the measured stage's time is reported.
 
-#[path = "../examples/broadphase/bvh.rs"]
-#[allow(dead_code)]
-mod bvh;
-mod common;
-#[path = "../examples/broadphase/scene.rs"]
-mod scene;
+use bvkit_support::broadphase::bvh;
+use bvkit_support::broadphase::scene;
+use bvkit_support::common;
 
 use std::hint::black_box;
 

@@ -6,7 +6,7 @@
 //! translation 12 (60), rigid 28 (76), similarity 32 (80), scale-rotation-translation 40
 //! (88), affine 48 (96).
 
-mod common;
+use bvkit_support::common;
 
 use std::hint::black_box;
 

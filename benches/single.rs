@@ -1,7 +1,7 @@
 //! Single-box kernels over a loop of 1024 boxes, with peers in the same group.
 //! `cargo bench --bench single`.
 
-mod common;
+use bvkit_support::common;
 
 use std::hint::black_box;
 use std::time::Duration;

@@ -5,7 +5,7 @@
 //! and the 2D classes as AoS slices. The CPU and the backend are printed first.
 //! `cargo bench --bench speed`; `scripts/bench_report.py speed` tabulates a run.
 
-mod common;
+use bvkit_support::common;
 
 use std::hint::black_box;
 

@@ -4,9 +4,8 @@
 //! bytes per triangle are printed once before the timings (`examples/trees.rs` prints the
 //! full comparison). `cargo bench --bench trees`.
 
-mod common;
-#[path = "../tests/trimesh/mod.rs"]
-mod trimesh;
+use bvkit_support::common;
+use bvkit_support::trimesh;
 
 use std::hint::black_box;
 use std::ops::ControlFlow;

@@ -6,8 +6,7 @@
 //! `cargo run --release --example fit [--quick]`: with `--quick`, two small meshes and one
 //! timed run each, to check that the report runs (CI).
 
-#[path = "../tests/meshes/mod.rs"]
-mod meshes;
+use bvkit_support::meshes;
 
 use bvkit::{Capsule, Fit, Obb3, Sphere};
 use glam::{DMat3, DQuat, DVec3, Vec3};

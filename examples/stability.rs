@@ -1,13 +1,8 @@
-//! Writes the extremes matrix to `docs/STABILITY.md` (or to the path given):
-//! `cargo run --release --example stability [PATH]`. Exits with an error on any contract
-//! failure.
+//! Writes the extremes matrix to `target/stability.md` (or to the path given):
+//! `cargo run --release --example stability [PATH]`; `python3 scripts/docs.py stability`
+//! puts it in `docs/stability.md`. Exits with an error on any contract failure.
 
-#[path = "../tests/cases/mod.rs"]
-mod cases;
-#[path = "../tests/matrix/mod.rs"]
-mod matrix;
-#[path = "../tests/oracle/mod.rs"]
-mod oracle;
+use bvkit_support::matrix;
 
 fn main() -> std::io::Result<()> {
     let cells = matrix::compute();
@@ -15,7 +10,7 @@ fn main() -> std::io::Result<()> {
     let path = std::path::PathBuf::from(
         std::env::args()
             .nth(1)
-            .unwrap_or_else(|| "docs/STABILITY.md".into()),
+            .unwrap_or_else(|| "target/stability.md".into()),
     );
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;

@@ -8,8 +8,7 @@
 //! `cargo run --release --example trees [--quick]`: with `--quick`, 8 poses per scene and
 //! one timed run each, to check that the report runs (CI).
 
-#[path = "../tests/trimesh/mod.rs"]
-mod trimesh;
+use bvkit_support::trimesh;
 
 use std::cell::Cell;
 use std::hint::black_box;

@@ -1,6 +1,6 @@
 //! The box types, the Mat4 entry points and the projective path.
 
-mod oracle;
+use bvkit_support::oracle;
 
 use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding, TransformError};
 use glam::{Affine2, Affine3A, Mat4, Quat, Vec2, Vec3, Vec3A};

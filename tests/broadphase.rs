@@ -3,8 +3,8 @@
 //! backend and layout; and its refusals.
 #![allow(clippy::needless_range_loop)]
 
-mod cases;
-mod oracle;
+use bvkit_support::cases;
+use bvkit_support::oracle;
 
 use bvkit::broadphase::{LargePose, LargeWorld};
 use bvkit::{

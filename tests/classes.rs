@@ -2,10 +2,10 @@
 //! the exact oracle and the scalar reference, at awkward lengths and over every extreme
 //! class; and the batch entry point's length checks.
 
-mod cases;
+use bvkit_support::cases;
 #[cfg(target_arch = "x86_64")]
-mod mxcsr;
-mod oracle;
+use bvkit_support::mxcsr;
+use bvkit_support::oracle;
 
 use bvkit::transform::{Transform2, Transform3};
 use bvkit::{

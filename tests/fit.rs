@@ -17,9 +17,8 @@
 //! Each check is shown to fail on a volume shrunk by one part in a million.
 #![allow(clippy::needless_range_loop)]
 
-mod meshes;
-mod oracle;
-mod volumes;
+use bvkit_support::meshes;
+use bvkit_support::volumes;
 
 use bvkit::{Aabb3, Capsule, Fit, FitError, Obb3, Sphere};
 use glam::{Mat3A, Quat, Vec3, Vec3A};

@@ -5,9 +5,9 @@
 //! `C + k·√N` compared exactly) is `tests/volumes/world.rs`, shared with the fuzz targets.
 #![allow(clippy::needless_range_loop)]
 
-mod cases;
-mod oracle;
-mod volumes;
+use bvkit_support::cases;
+use bvkit_support::oracle;
+use bvkit_support::volumes;
 
 use bvkit::{
     Aabb3, BatchError, BoundingVolume, Capsule, Obb3, Rigid3, Rounding, Similarity3, Translation3,

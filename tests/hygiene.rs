@@ -13,8 +13,8 @@
 //! and `6e-8` entries), zero-size boxes, a box at the origin, faces at zero.
 #![cfg(target_arch = "x86_64")]
 
-mod mxcsr;
-mod trimesh;
+use bvkit_support::mxcsr;
+use bvkit_support::trimesh;
 
 use bvkit::broadphase::LargeWorld;
 use bvkit::transform::{Transform2, Transform3};

@@ -3,8 +3,8 @@
 //! extreme inputs mixed in and lengths that leave short last parts and lane tails.
 #![cfg(feature = "rayon")]
 
-mod cases;
-mod oracle;
+use bvkit_support::cases;
+use bvkit_support::oracle;
 
 use bvkit::{Aabb3, Aabb3x8, Backend, Batch, Block8, Method, Rigid3, Rounding, Soa};
 use glam::Affine3A;

@@ -1,8 +1,8 @@
 //! The single-box contract, checked against the exact oracle for every method, rounding,
 //! dimension and path (glam SIMD and scalar), over every extreme class.
 
-mod cases;
-mod oracle;
+use bvkit_support::cases;
+use bvkit_support::oracle;
 
 use bvkit::{Method, Rigid2, Rounding};
 use glam::Vec2;

@@ -1,8 +1,6 @@
 //! The extremes matrix: every extreme class × every kernel × every path keeps the contract.
 
-mod cases;
-mod matrix;
-mod oracle;
+use bvkit_support::matrix;
 
 #[test]
 fn every_cell_of_the_extremes_matrix_keeps_the_contract() {

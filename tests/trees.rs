@@ -5,8 +5,8 @@
 //! - the triangle test against an exact separating-axis reference;
 //! - errors, refit, layouts and their sizes.
 
-mod sat;
-mod trimesh;
+use bvkit_support::sat;
+use bvkit_support::trimesh;
 
 use std::ops::ControlFlow;
 

@@ -12,10 +12,8 @@
 //!   [--partial K]`: two whole broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage
 //!   by stage; the options tune bvkit's pipeline.
 
-mod bvh;
-#[path = "../../benches/common/mod.rs"]
-mod common;
-mod scene;
+use bvkit_support::broadphase::{bvh, scene};
+use bvkit_support::common;
 
 use std::time::Instant;
 

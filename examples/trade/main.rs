@@ -18,13 +18,10 @@
 //! goes to stderr. Timings vary run to run; the accuracy columns are identical for the
 //! fixed seed.
 
-#[path = "../../tests/cases/mod.rs"]
-mod cases;
-#[path = "../../benches/common/mod.rs"]
-mod common;
+use bvkit_support::cases;
+use bvkit_support::common;
 mod measure;
-#[path = "../../tests/oracle/mod.rs"]
-mod oracle;
+use bvkit_support::oracle;
 mod plot;
 mod report;
 

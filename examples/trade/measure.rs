@@ -474,6 +474,47 @@ fn flat2(b: &Aabb2) -> ([f32; 2], [f32; 2]) {
     (b.min.to_array(), b.max.to_array())
 }
 
+/// The faces of a box as the oracle reads them.
+trait Faces<const N: usize>: Copy {
+    fn faces(&self) -> ([f32; N], [f32; N]);
+}
+
+impl Faces<3> for Aabb3 {
+    fn faces(&self) -> ([f32; 3], [f32; 3]) {
+        flat3(self)
+    }
+}
+
+impl Faces<2> for Aabb2 {
+    fn faces(&self) -> ([f32; 2], [f32; 2]) {
+        flat2(self)
+    }
+}
+
+/// One kernel on slices, `apply(boxes, poses, out)`: timed over the scene's boxes and poses
+/// (in cache and in DRAM) and judged by the oracle on the sample's.
+fn on_slices<B: Faces<N>, X, const N: usize, P: Exactly<N>>(
+    (boxes, xfs, out): (&[B], &[X], &mut [B]),
+    (sample, sb, sx): (&[(cases::Class, P)], &[B], &[X]),
+    bound: Bound,
+    mut apply: impl FnMut(&[B], &[X], &mut [B]),
+) -> ((f64, f64), Accuracy) {
+    let t = times(|n| apply(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n]));
+    let mut so = sb.to_vec();
+    apply(sb, sx, &mut so);
+    let results: Vec<_> = so.iter().map(Faces::faces).collect();
+    (t, accuracy(sample, &results, bound))
+}
+
+/// `apply` one box at a time over slices, as a user's loop does.
+fn each<B, X>(f: impl Fn(&B, &X) -> B) -> impl FnMut(&[B], &[X], &mut [B]) {
+    move |boxes, xfs, out| {
+        for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
+            *o = f(b, x);
+        }
+    }
+}
+
 /// The stages [`affine3d`] reports.
 pub const AFFINE3_STAGES: usize = 2 + Method::ALL.len() * Rounding::ALL.len();
 
@@ -553,62 +594,41 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     for k @ (method, rounding) in kernels() {
         progress.stage(&kernel_stage("3D affine", k));
         let bound = Bound::documented(method, rounding, 3);
-        let t = times(|n| {
-            for ((b, xf), o) in black_box(&boxes[..n])
-                .iter()
-                .zip(&xfs[..n])
-                .zip(&mut out[..n])
-            {
-                *o = b.transformed(xf, method, rounding);
-            }
-        });
-        let results: Vec<_> = sb
-            .iter()
-            .zip(&sx)
-            .map(|(b, x)| flat3(&b.transformed(x, method, rounding)))
-            .collect();
-        m.kernel(
-            k,
-            Layout::Single,
-            GLAM_SIMD,
-            t,
-            accuracy(&sample, &results, bound),
+        let (scene, judged) = (
+            (&boxes[..], &xfs[..], &mut out[..]),
+            (&sample[..], &sb[..], &sx[..]),
         );
-        let t = times(|n| {
-            for ((b, xf), o) in black_box(&boxes[..n])
-                .iter()
-                .zip(&xfs[..n])
-                .zip(&mut out[..n])
-            {
-                *o = b.transformed_scalar(xf, method, rounding);
-            }
-        });
-        let results: Vec<_> = sb
-            .iter()
-            .zip(&sx)
-            .map(|(b, x)| flat3(&b.transformed_scalar(x, method, rounding)))
-            .collect();
-        m.kernel(
-            k,
-            Layout::Single,
-            SCALAR,
-            t,
-            accuracy(&sample, &results, bound),
+        let (t, a) = on_slices(
+            scene,
+            judged,
+            bound,
+            each(|b: &Aabb3, x| b.transformed(x, method, rounding)),
         );
+        m.kernel(k, Layout::Single, GLAM_SIMD, t, a);
+        let (scene, judged) = (
+            (&boxes[..], &xfs[..], &mut out[..]),
+            (&sample[..], &sb[..], &sx[..]),
+        );
+        let (t, a) = on_slices(
+            scene,
+            judged,
+            bound,
+            each(|b: &Aabb3, x| b.transformed_scalar(x, method, rounding)),
+        );
+        m.kernel(k, Layout::Single, SCALAR, t, a);
 
         for &backend in backends {
             let batch = Batch::new(method, rounding).on(backend).expect("supported");
             let name = backend.name();
 
-            let t = times(|n| {
-                batch
-                    .transform(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
-                    .unwrap()
+            let (scene, judged) = (
+                (&boxes[..], &xfs[..], &mut out[..]),
+                (&sample[..], &sb[..], &sx[..]),
+            );
+            let (t, a) = on_slices(scene, judged, bound, |b, x, o| {
+                batch.transform(b, x, o).unwrap()
             });
-            let mut so = vec![Aabb3::EMPTY; sb.len()];
-            batch.transform(&sb, &sx, &mut so).unwrap();
-            let results: Vec<_> = so.iter().map(flat3).collect();
-            m.kernel(k, Layout::Aos, name, t, accuracy(&sample, &results, bound));
+            m.kernel(k, Layout::Aos, name, t, a);
 
             let t = (
                 ns_per_box(cache(), cache_runs(), || {
@@ -699,24 +719,20 @@ fn class3<T: Transform3, P: Exactly<3>, const F: usize>(
                 .expect("lengths")
         });
         m.kernel(k, Layout::Aosoa, best.name(), t, batch_accuracy);
-        let t = times(|n| {
-            batch
-                .transform(black_box(&boxes[..n]), black_box(&xfs[..n]), &mut out[..n])
-                .expect("lengths")
-        });
-        m.kernel(k, Layout::Aos, best.name(), t, batch_accuracy);
-        let results: Vec<_> = sb
-            .iter()
-            .zip(&sx)
-            .map(|(b, x)| flat3(&b.transformed(x, method, rounding)))
-            .collect();
-        let single_accuracy = accuracy(sample, &results, bound);
-        let t = times(|n| {
-            for ((b, x), o) in boxes[..n].iter().zip(&xfs[..n]).zip(&mut out[..n]) {
-                *o = black_box(b).transformed(x, method, rounding);
-            }
-        });
-        m.kernel(k, Layout::Single, GLAM_SIMD, t, single_accuracy);
+        let (t, a) = on_slices(
+            (boxes, xfs, &mut out),
+            (sample, &sb, &sx),
+            bound,
+            |b, x, o| batch.transform(b, x, o).expect("lengths"),
+        );
+        m.kernel(k, Layout::Aos, best.name(), t, a);
+        let (t, a) = on_slices(
+            (boxes, xfs, &mut out),
+            (sample, &sb, &sx),
+            bound,
+            each(|b: &Aabb3, x| b.transformed(x, method, rounding)),
+        );
+        m.kernel(k, Layout::Single, GLAM_SIMD, t, a);
     }
 }
 
@@ -839,105 +855,66 @@ pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
         affine_sample.iter().map(|(_, p)| affine2(p)).unzip();
     let (rb, rx): (Vec<Aabb2>, Vec<Rigid2>) = rigid_sample.iter().map(|(_, p)| rigid2(p)).unzip();
     let mut out = vec![Aabb2::EMPTY; dram()];
-    let mut o = vec![Aabb2::EMPTY; rb.len()];
     let mut mt = Meter::new(TransformClass::Translation2, progress);
     let mut mr = Meter::new(TransformClass::Rigid2, progress);
     let mut ma = Meter::new(TransformClass::Affine2, progress);
     for k @ (method, rounding) in kernels() {
         progress.stage(&kernel_stage("2D", k));
         let b2 = Bound::documented(method, rounding, 2);
-        let t = times(|n| {
-            for ((b, xf), o) in black_box(&boxes[..n])
-                .iter()
-                .zip(&rigid[..n])
-                .zip(&mut out[..n])
-            {
-                *o = b.transformed_rigid(xf, method, rounding);
-            }
-        });
-        let results: Vec<_> = rb
-            .iter()
-            .zip(&rx)
-            .map(|(b, x)| flat2(&b.transformed_rigid(x, method, rounding)))
-            .collect();
-        let a = accuracy(&rigid_sample, &results, b2);
-        mr.kernel(k, Layout::Single, SCALAR, t, a);
-        let t = times(|n| {
-            for ((b, xf), o) in black_box(&boxes[..n])
-                .iter()
-                .zip(&affine[..n])
-                .zip(&mut out[..n])
-            {
-                *o = b.transformed(xf, method, rounding);
-            }
-        });
-        let results: Vec<_> = ab
-            .iter()
-            .zip(&ax)
-            .map(|(b, x)| flat2(&b.transformed(x, method, rounding)))
-            .collect();
-        let a = accuracy(&affine_sample, &results, b2);
-        ma.kernel(k, Layout::Single, SCALAR, t, a);
         let bt = Bound::of_order(Translation2::nearest_gamma(method), rounding);
-        let t = times(|n| {
-            for ((b, xf), o) in black_box(&boxes[..n])
-                .iter()
-                .zip(&translation[..n])
-                .zip(&mut out[..n])
-            {
-                *o = b.transformed(xf, method, rounding);
-            }
-        });
-        let results: Vec<_> = tb
-            .iter()
-            .zip(&tx)
-            .map(|(b, x)| flat2(&b.transformed(x, method, rounding)))
-            .collect();
-        let a = accuracy(&translation_sample, &results, bt);
+        let (rigid_judged, affine_judged, translation_judged) = (
+            (&rigid_sample[..], &rb[..], &rx[..]),
+            (&affine_sample[..], &ab[..], &ax[..]),
+            (&translation_sample[..], &tb[..], &tx[..]),
+        );
+        let single = each(|b: &Aabb2, x: &Rigid2| b.transformed_rigid(x, method, rounding));
+        let (t, a) = on_slices(
+            (&boxes[..], &rigid[..], &mut out[..]),
+            rigid_judged,
+            b2,
+            single,
+        );
+        mr.kernel(k, Layout::Single, SCALAR, t, a);
+        let single = each(|b: &Aabb2, x: &Affine2| b.transformed(x, method, rounding));
+        let (t, a) = on_slices(
+            (&boxes[..], &affine[..], &mut out[..]),
+            affine_judged,
+            b2,
+            single,
+        );
+        ma.kernel(k, Layout::Single, SCALAR, t, a);
+        let single = each(|b: &Aabb2, x: &Translation2| b.transformed(x, method, rounding));
+        let (t, a) = on_slices(
+            (&boxes[..], &translation[..], &mut out[..]),
+            translation_judged,
+            bt,
+            single,
+        );
         mt.kernel(k, Layout::Single, SCALAR, t, a);
-        let batch = Batch::new(method, rounding)
-            .on(backends[0])
-            .expect("supported");
-        let t = times(|n| {
-            batch
-                .transform(
-                    black_box(&boxes[..n]),
-                    black_box(&translation[..n]),
-                    &mut out[..n],
-                )
-                .unwrap()
-        });
-        batch.transform(&tb, &tx, &mut o).unwrap();
-        let results: Vec<_> = o.iter().map(flat2).collect();
-        let a = accuracy(&translation_sample, &results, bt);
-        mt.kernel(k, Layout::Aos, backends[0].name(), t, a);
-        for &backend in backends {
+        for (i, &backend) in backends.iter().enumerate() {
             let batch = Batch::new(method, rounding).on(backend).expect("supported");
-            let t = times(|n| {
-                batch
-                    .transform(
-                        black_box(&boxes[..n]),
-                        black_box(&rigid[..n]),
-                        &mut out[..n],
-                    )
-                    .unwrap()
-            });
-            batch.transform(&rb, &rx, &mut o).unwrap();
-            let results: Vec<_> = o.iter().map(flat2).collect();
-            let a = accuracy(&rigid_sample, &results, b2);
+            if i == 0 {
+                let (t, a) = on_slices(
+                    (&boxes[..], &translation[..], &mut out[..]),
+                    translation_judged,
+                    bt,
+                    |b, x, o| batch.transform(b, x, o).unwrap(),
+                );
+                mt.kernel(k, Layout::Aos, backend.name(), t, a);
+            }
+            let (t, a) = on_slices(
+                (&boxes[..], &rigid[..], &mut out[..]),
+                rigid_judged,
+                b2,
+                |b, x, o| batch.transform(b, x, o).unwrap(),
+            );
             mr.kernel(k, Layout::Aos, backend.name(), t, a);
-            let t = times(|n| {
-                batch
-                    .transform(
-                        black_box(&boxes[..n]),
-                        black_box(&affine[..n]),
-                        &mut out[..n],
-                    )
-                    .unwrap()
-            });
-            batch.transform(&ab, &ax, &mut o).unwrap();
-            let results: Vec<_> = o.iter().map(flat2).collect();
-            let a = accuracy(&affine_sample, &results, b2);
+            let (t, a) = on_slices(
+                (&boxes[..], &affine[..], &mut out[..]),
+                affine_judged,
+                b2,
+                |b, x, o| batch.transform(b, x, o).unwrap(),
+            );
             ma.kernel(k, Layout::Aos, backend.name(), t, a);
         }
     }

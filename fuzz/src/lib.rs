@@ -1,11 +1,9 @@
 //! Decoding of fuzz input into boxes and transforms, and the contract checks every fuzz
-//! target applies (through the exact oracle of `tests/oracle`).
+//! target applies (through the exact oracle of the support crate).
 
-#[path = "../../tests/oracle/mod.rs"]
-pub mod oracle;
+pub use bvkit_support::oracle;
 
-#[path = "../../tests/volumes/mod.rs"]
-pub mod volumes;
+pub use bvkit_support::volumes;
 
 use bvkit::tree::{Object, QueryError};
 use bvkit::{Aabb2, Capsule, Method, Obb3, Rigid2, Rounding, Similarity3, Sphere};

@@ -5,7 +5,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 
-use super::oracle::{Problem, QuatProblem};
+use crate::oracle::{Problem, QuatProblem};
 
 /// The classes of input the contract is tested over.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -38,8 +38,8 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
 
+use super::scene::Scene;
 use crate::common::cpu;
-use crate::scene::Scene;
 
 /// The margin both pipelines give a box when its leaf is rewritten (B's relative part is
 /// zero, so that its fat boxes are A's enlarged boxes at the same instant).

@@ -1,7 +1,7 @@
 //! The extremes matrix: every extreme class against every kernel, each cell checked
 //! against the contract by the exact oracle and summarised (worst error in `u·S`, mean
 //! volume overhead, outcome). `tests/stability.rs` asserts it; `examples/stability.rs`
-//! writes it to `docs/STABILITY.md`.
+//! writes it (`python3 scripts/docs.py stability` into `docs/stability.md`).
 #![allow(dead_code)]
 
 use bvkit::{
@@ -12,8 +12,8 @@ use glam::{Vec2, Vec3A};
 use rand::RngExt;
 use rand::rngs::StdRng;
 
-use super::cases::{Class, Scale, as_translation, bend_quat, problem, rng};
-use super::oracle::{
+use crate::cases::{Class, Scale, as_translation, bend_quat, problem, rng};
+use crate::oracle::{
     Bound, Exactly, Expected, Problem, QuatProblem, affine2, affine3, check, rigid2,
 };
 

@@ -1,0 +1,17 @@
+//! What bvkit's tests, benches, examples and fuzz targets share: the exact oracle, the input
+//! classes, the meshes, the scenes and the peers. Not published.
+// `Dy::cmp` and `Rng::next` were private to the tests that moved here; as public items
+// clippy would have them implement `Ord` and `Iterator`, which they do not need.
+#![allow(clippy::needless_range_loop, clippy::should_implement_trait)]
+
+pub mod broadphase;
+pub mod cases;
+pub mod common;
+pub mod matrix;
+pub mod meshes;
+#[cfg(target_arch = "x86_64")]
+pub mod mxcsr;
+pub mod oracle;
+pub mod sat;
+pub mod trimesh;
+pub mod volumes;
