@@ -9,7 +9,7 @@
 //! bytes written, and its index). Active subsets are sorted random index lists.
 //!
 //! The `pipeline` groups run the broadphase example's two pipelines on parry3d's `Bvh`
-//! (`examples/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
+//! (`support/src/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
 //! bodies all awake and at 1M with half asleep, stage by stage, and B again with a relative
 //! margin of 0.3 (`--relative 0.3` in the example): each sample is one frame of both
 //! pipelines, of which the measured stage's time is reported.

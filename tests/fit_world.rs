@@ -2,7 +2,7 @@
 //! ([`BoundingVolume::transformed_aabb`]) under every 3D class × rounding over every extreme
 //! class of inputs, the batch entry point against the single calls, and the images under
 //! similarities ([`Obb3::transformed`], …). The exact judgement (rational corners, faces
-//! `C + k·√N` compared exactly) is `tests/volumes/world.rs`, shared with the fuzz targets.
+//! `C + k·√N` compared exactly) is `support/src/volumes/world.rs`, shared with the fuzz targets.
 #![allow(clippy::needless_range_loop)]
 
 use bvkit_support::cases;

@@ -7,7 +7,7 @@
 //! would otherwise write (the glam loops, the parry3d loop) and the memory rooflines:
 //!
 //! - ns per box at an in-cache batch and a DRAM-sized batch (medians of repeated runs);
-//! - against the exact oracle (`tests/oracle`), on a seeded sample over the finite
+//! - against the exact oracle (`support/src/oracle.rs`), on a seeded sample over the finite
 //!   extreme classes: the worst face error in units of `u·S`, the fraction of results
 //!   that contain the exact box, and the mean volume overhead over the exact box.
 //!

@@ -3,11 +3,10 @@
 //! the count differs, and then leaves the tree as it was; a query errs only for a pose that
 //! cannot be placed ([`bvkit_fuzz::query_error_justified`]); otherwise `leaf_pairs` holds
 //! every pair whose exact boxes overlap under the query's map (the exact rational
-//! separating-axis test of `tests/sat`), each once, and only pairs that pass the box test.
+//! separating-axis test of `support/src/sat.rs`), each once, and only pairs that pass the box test.
 #![no_main]
 
-#[path = "../../tests/sat/mod.rs"]
-mod sat;
+use bvkit_support::sat;
 
 use bvkit::tree::{AabbTree, Compact, Layout, Quantized};
 use bvkit::{Aabb3, Rigid3};

@@ -6,8 +6,7 @@
 //! pose that cannot be placed: never a silent "no contact").
 #![no_main]
 
-#[path = "../../tests/sat/mod.rs"]
-mod sat;
+use bvkit_support::sat;
 
 use bvkit::tree::{QueryError, Relative, TriMesh, triangles_intersect};
 use bvkit::{Aabb3, Rigid3};

@@ -4,8 +4,10 @@
 // clippy would have them implement `Ord` and `Iterator`, which they do not need.
 #![allow(clippy::needless_range_loop, clippy::should_implement_trait)]
 
+#[cfg(feature = "peers")]
 pub mod broadphase;
 pub mod cases;
+#[cfg(feature = "peers")]
 pub mod common;
 pub mod matrix;
 pub mod meshes;

@@ -1,4 +1,4 @@
-//! Test meshes: the real ones in `tests/data` (read with a tiny OBJ `v`-line reader) and
+//! Test meshes: the real ones in `support/data` (read with a tiny OBJ `v`-line reader) and
 //! procedural ones. Shared by `tests/fit.rs` and `examples/fit.rs`.
 #![allow(dead_code)]
 

@@ -2,7 +2,7 @@
 //! products stay dyadic): a box against a box placed by an `f64` affine map, and two
 //! triangles. Shared by `tests/trees.rs` and the `tree` fuzz target.
 //!
-//! The crate's fixed-point oracle (`tests/oracle`) stops at products of four `f32` values;
+//! The crate's fixed-point oracle (`support/src/oracle.rs`) stops at products of four `f32` values;
 //! the relative map here is an `f64` matrix and the cross axes are products of three of its
 //! entries, so this module carries its own exponent.
 #![allow(dead_code)]
