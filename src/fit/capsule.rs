@@ -188,8 +188,8 @@ fn smallest(shapes: impl IntoIterator<Item = Shape>) -> Shape {
 fn pca_shape(points: &[Vec3]) -> Shape {
     let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
     let unique_f32: Vec<Vec3> = distinct.iter().map(|p| p.as_vec3()).collect();
-    let mean = cloud::mean(&unique_f32);
-    let dir = principal_axes(cloud::covariance(&unique_f32, mean)).x_axis;
+    let moments = cloud::summary(&unique_f32);
+    let (mean, dir) = (moments.mean, principal_axes(moments.covariance).x_axis);
     let radius = distinct
         .iter()
         .map(|&p| (p - mean).reject_from_normalized(dir).length())

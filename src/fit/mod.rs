@@ -25,6 +25,7 @@ mod obb;
 mod rect;
 mod search;
 mod sphere;
+mod sweep;
 mod world;
 
 pub use capsule::Capsule;

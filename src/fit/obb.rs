@@ -1,24 +1,15 @@
 //! Oriented bounding boxes and their fits.
 
 use super::bound::{Bounded, sum_magnitude};
-use super::cloud::{self, DIRECTIONS, exact};
+use super::cloud::{self, exact};
 use alloc::vec;
 use alloc::vec::Vec;
 
-/// DiTO-14's sample directions: the first 7 of [`DIRECTIONS`].
-const DITO_DIRECTIONS: [Vec3; 7] = [
-    DIRECTIONS[0],
-    DIRECTIONS[1],
-    DIRECTIONS[2],
-    DIRECTIONS[3],
-    DIRECTIONS[4],
-    DIRECTIONS[5],
-    DIRECTIONS[6],
-];
 use super::eigen::principal_axes;
 use super::hull::{Hull, convex_hull};
 use super::rect::min_area_rectangle;
 use super::search::compass_search;
+use super::sweep;
 use super::{Fit, FitError};
 use crate::Aabb3;
 use alloc::collections::BTreeMap;
@@ -160,33 +151,27 @@ fn to_f32(frame: DMat3) -> Mat3A {
     )
 }
 
-/// The boxes with the given axes holding `points`, in one pass, certified.
+/// The boxes with the given axes holding `points`, certified.
 ///
 /// For an axis `a` (exact `f32`) and a point `p`, `p·a` in `f64` has exact products and two
-/// rounded sums: it is within `γ(2)·S` of the exact value, `S = Σ_j |a_j|·max(|min_j|, |max_j|)`
-/// over the bounding box. So every exact projection lies in `[lo − γ(2)S, hi + γ(2)S]` for
-/// the computed extremes `lo`, `hi`. With the center `c` rounded to `f32` and `c·a` within
-/// `γ(2)·C` (`C = Σ_j |c_j a_j|`), every `|(p − c)·a|` is at most
-/// `max(hi − c·a, c·a − lo) + γ(2)(S + C)`; one more rounding for that difference, and the
-/// lemma's `Bounded::upper` with `scale = S + C` is a certified half-extent.
+/// rounded sums ([`sweep::projection_ranges`]): it is within `γ(2)·S` of the exact value,
+/// `S = Σ_j |a_j|·max(|min_j|, |max_j|)` over the bounding box. So every exact projection
+/// lies in `[lo − γ(2)S, hi + γ(2)S]` for the computed extremes `lo`, `hi`. With the center
+/// `c` rounded to `f32` and `c·a` within `γ(2)·C` (`C = Σ_j |c_j a_j|`), every `|(p − c)·a|`
+/// is at most `max(hi − c·a, c·a − lo) + γ(2)(S + C)`; one more rounding for that
+/// difference, and the lemma's `Bounded::upper` with `scale = S + C` is a certified
+/// half-extent.
 fn fit_axes<const N: usize>(
     points: &[Vec3],
     bounds: &Aabb3,
     rotations: [Mat3A; N],
     center: Center,
 ) -> [Result<Obb3, FitError>; N] {
-    let axes = rotations.map(|r| r.as_dmat3().transpose());
-    let mut lo = [DVec3::INFINITY; N];
-    let mut hi = [DVec3::NEG_INFINITY; N];
-    for &p in points {
-        let p = exact(p);
-        for r in 0..N {
-            let q = axes[r] * p;
-            lo[r] = lo[r].min(q);
-            hi[r] = hi[r].max(q);
-        }
-    }
-    core::array::from_fn(|r| certified_box(rotations[r], lo[r], hi[r], bounds, center))
+    let ranges = sweep::projection_ranges(points, rotations);
+    core::array::from_fn(|r| {
+        let (lo, hi) = ranges[r];
+        certified_box(rotations[r], lo, hi, bounds, center)
+    })
 }
 
 /// The certified box with axes `rotation` whose computed projection range is `[lo, hi]`
@@ -314,21 +299,46 @@ fn smallest(boxes: impl IntoIterator<Item = Result<Obb3, FitError>>) -> Result<O
 /// their mean, half-extents the largest `|projection|` about it.
 fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     let distinct = cloud::unique(points);
-    let mean = cloud::mean(&distinct);
-    let axes = principal_axes(cloud::covariance(&distinct, mean));
+    let moments = cloud::summary(&distinct);
+    let (mean, axes) = (moments.mean, principal_axes(moments.covariance));
     let [obb] = fit_axes(&distinct, bounds, [to_f32(axes)], Center::At(mean));
     obb
 }
 
+/// How many face normals of the extremal points' hull the fast fit tries: all of them (a
+/// hull of 26 points has at most 48 faces).
+const FAST_NORMALS: usize = 48;
+
 /// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
-/// points as given) and the best DiTO frame.
+/// points as given) and the best frame of the extremal points along the 13 sample
+/// directions ([`super::sweep::projections`]). Those few points stand in for the points:
+/// DiTO's frames of the first 14 and the face frames of the hull of all 26
+/// ([`face_frames`]) are ranked by the volume they give them, and the best is measured on
+/// every point.
 fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
-    let pca = principal_axes(cloud::covariance(points, cloud::mean(points)));
-    let extremal = cloud::extremal_points(points, &DITO_DIRECTIONS);
-    let dito = dito_frames(&extremal)
+    let summary = cloud::summary(points);
+    let pca = principal_axes(summary.covariance);
+    let mut extremal = summary.extremal;
+    let dito = dito_frames(&extremal[..14]);
+    extremal.sort_by(|a, b| {
+        a.to_array()
+            .partial_cmp(&b.to_array())
+            .unwrap_or(core::cmp::Ordering::Equal)
+    });
+    extremal.dedup();
+    let faces = match convex_hull(&extremal) {
+        Hull::Solid {
+            vertices,
+            triangles,
+        } => face_frames(&vertices, &triangles, FAST_NORMALS),
+        _ => Vec::new(),
+    };
+    let best = dito
         .into_iter()
-        .min_by(|a, b| volume_over(a, &extremal).total_cmp(&volume_over(b, &extremal)))
-        .unwrap_or(pca);
+        .map(|f| (volume_over(&f, &extremal), f))
+        .chain(faces)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(pca, |(_, f)| f);
     // The coordinate axes' projection range is the bounding box itself, exactly.
     let aabb = certified_box(
         Mat3A::IDENTITY,
@@ -337,7 +347,7 @@ fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
         bounds,
         Center::Midrange,
     );
-    let rotations = [pca, dito].map(to_f32);
+    let rotations = [to_f32(pca), to_f32(best)];
     smallest(
         fit_axes(points, bounds, rotations, Center::Midrange)
             .into_iter()
@@ -442,12 +452,7 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
             vertices,
             triangles,
         } => {
-            let mut scored: Vec<(f64, DMat3)> = face_normals(&vertices, &triangles)
-                .into_iter()
-                .map(|n| rectangle_frame(n, &vertices))
-                .map(|f| (volume_over(&f, &vertices), f))
-                .collect();
-            scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let scored = face_frames(&vertices, &triangles, MAX_FACE_NORMALS);
             let frames = scored
                 .iter()
                 .take(REFINED)
@@ -461,9 +466,22 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
     }
 }
 
+/// For each distinct face normal of a hull ([`face_normals`]), the frame of the
+/// minimum-area rectangle around the hull along it, with the volume of its box; smallest
+/// first.
+fn face_frames(vertices: &[DVec3], triangles: &[[usize; 3]], normals: usize) -> Vec<(f64, DMat3)> {
+    let mut scored: Vec<(f64, DMat3)> = face_normals(vertices, triangles, normals)
+        .into_iter()
+        .map(|n| rectangle_frame(n, vertices))
+        .map(|f| (volume_over(&f, vertices), f))
+        .collect();
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored
+}
+
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
 /// [`MAX_FACE_NORMALS`].
-fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
+fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Vec<DVec3> {
     let mut by_direction: BTreeMap<[i64; 3], (f64, DVec3)> = BTreeMap::new();
     for t in triangles {
         let [a, b, c] = t.map(|i| vertices[i]);
@@ -480,11 +498,7 @@ fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]]) -> Vec<DVec3> {
     }
     let mut normals: Vec<(f64, DVec3)> = by_direction.into_values().collect();
     normals.sort_by(|a, b| b.0.total_cmp(&a.0));
-    normals
-        .into_iter()
-        .take(MAX_FACE_NORMALS)
-        .map(|(_, n)| n)
-        .collect()
+    normals.into_iter().take(most).map(|(_, n)| n).collect()
 }
 
 /// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the

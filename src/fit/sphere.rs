@@ -2,7 +2,7 @@
 
 use super::ball::smallest_ball;
 use super::bound::{Bounded, largest, segment_distance};
-use super::cloud::{self, DIRECTIONS, exact};
+use super::cloud::{self, exact};
 use super::{Fit, FitError};
 use crate::Aabb3;
 use alloc::vec::Vec;
@@ -35,7 +35,7 @@ impl Sphere {
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
         let bounds = cloud::validate(points)?;
         let center = match fit {
-            Fit::Pca => cloud::mean(&cloud::unique(points)),
+            Fit::Pca => cloud::summary(&cloud::unique(points)).mean,
             Fit::Fast => fast_center(points),
             Fit::Tight => smallest_center(points),
         };
@@ -114,11 +114,12 @@ fn smallest_center(points: &[Vec3]) -> DVec3 {
     DVec3::from_array(smallest_ball(&distinct).center)
 }
 
-/// The fast center: the smallest ball of the extremal points along [`DIRECTIONS`] (EPOS-26,
-/// Larsson 2008), then up to [`FAST_PASSES`] times: find the farthest point from the center,
+/// The fast center: the smallest ball of the extremal points along the 13 sample
+/// directions ([`super::sweep::projections`]; EPOS-26, Larsson 2008), then up to [`FAST_PASSES`] times: find the farthest point from the center,
 /// and if it lies outside, add it to the support set and take the smallest ball again.
 fn fast_center(points: &[Vec3]) -> DVec3 {
-    let mut support: Vec<[f64; 3]> = cloud::extremal_points(points, &DIRECTIONS)
+    let mut support: Vec<[f64; 3]> = cloud::summary(points)
+        .extremal
         .iter()
         .map(|p| p.to_array())
         .collect();

@@ -1,0 +1,414 @@
+//! Sweeps: the linear passes of the fits over every input point, in lanes.
+//!
+//! Each sweep is one pass on the running CPU's best backend ([`Backend::detect`]), run
+//! unfused, so that its result does not depend on the backend: the same bits on every CPU,
+//! and the same as one point at a time in the same order of operations.
+//! - [`extremal_points`] runs on the backend's `f32` lane type: each block of points is
+//!   transposed into coordinate columns and projected on every direction at once.
+//! - [`mean`], [`covariance`] and [`projection_ranges`] compute in `f64` on arrays of
+//!   [`WIDTH`] points, compiled inside the backend's dispatch wrapper so that they
+//!   vectorise for its instructions. Sums keep [`WIDTH`] partial sums (point `i` goes to
+//!   sum `i mod WIDTH`), added in order at the end.
+
+use crate::Aabb3;
+use crate::simd::{self, Backend, Job, LaneArray};
+use alloc::vec::Vec;
+use glam::{DMat3, DVec3, Mat3A, Vec3, Vec3A};
+
+/// Points per block.
+const WIDTH: usize = 8;
+
+/// The full blocks of `points`, then the last, partial one (if any) padded with `pad`, and
+/// how many of its points are real. Full blocks are read in place: a block copied to the
+/// stack and read back in another shape stalls store forwarding.
+#[inline(always)]
+fn blocks(
+    points: &[Vec3],
+    pad: Vec3,
+) -> (impl Iterator<Item = &[Vec3; WIDTH]>, [Vec3; WIDTH], usize) {
+    let full = points.chunks_exact(WIDTH);
+    let rest = full.remainder();
+    let mut tail = [pad; WIDTH];
+    tail[..rest.len()].copy_from_slice(rest);
+    let full = full.map(|b| <&[Vec3; WIDTH]>::try_from(b).expect("chunks of WIDTH"));
+    (full, tail, rest.len())
+}
+
+/// The coordinate columns of [`WIDTH`] points, in plain indexed loops (closures of
+/// `array::from_fn` are not always inlined), so that the transposition compiles to vector
+/// loads and shuffles.
+#[inline(always)]
+fn columns(block: &[Vec3; WIDTH]) -> [[f32; WIDTH]; 3] {
+    let mut c = [[0.0f32; WIDTH]; 3];
+    for j in 0..WIDTH {
+        c[0][j] = block[j].x;
+        c[1][j] = block[j].y;
+        c[2][j] = block[j].z;
+    }
+    c
+}
+
+/// [`columns`] as exact `f64`.
+#[inline(always)]
+fn columns_f64(block: &[Vec3; WIDTH]) -> [[f64; WIDTH]; 3] {
+    let f = columns(block);
+    let mut c = [[0.0f64; WIDTH]; 3];
+    for i in 0..3 {
+        for j in 0..WIDTH {
+            c[i][j] = f64::from(f[i][j]);
+        }
+    }
+    c
+}
+
+/// A job that ignores the lane type: plain array code, compiled with the features of the
+/// backend's dispatch wrapper; it leaves its result in `out`.
+struct Plain<'a, T, F: FnOnce() -> T> {
+    f: F,
+    out: &'a mut Option<T>,
+}
+
+impl<T, F: FnOnce() -> T> Job for Plain<'_, T, F> {
+    #[inline(always)]
+    fn run<L: LaneArray>(self) {
+        *self.out = Some((self.f)());
+    }
+}
+
+/// Runs `f` on the best backend, unfused (the same bits on every backend). Its state lives
+/// in locals that it returns: conditional writes through captured references do not
+/// vectorise.
+#[inline(always)]
+fn sweep<T>(f: impl FnOnce() -> T) -> T {
+    let mut out = None;
+    simd::dispatch(Backend::detect(), false, Plain { f, out: &mut out });
+    out.expect("every backend runs the job")
+}
+
+/// The bounding box of the points, or the index of the first point with a NaN or infinite
+/// coordinate.
+pub(crate) fn bounds(points: &[Vec3]) -> Result<Aabb3, usize> {
+    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    let (lo, hi, finite) = sweep(
+        #[inline(always)]
+        || {
+            let mut lo = [[f32::INFINITY; WIDTH]; 3];
+            let mut hi = [[f32::NEG_INFINITY; WIDTH]; 3];
+            let mut finite = [true; WIDTH];
+            let (full, tail, _) = blocks(points, pad);
+            for block in full.chain([&tail]) {
+                let c = columns(block);
+                for i in 0..3 {
+                    for j in 0..WIDTH {
+                        let x = c[i][j];
+                        finite[j] &= x.abs() < f32::INFINITY;
+                        lo[i][j] = if x < lo[i][j] { x } else { lo[i][j] };
+                        hi[i][j] = if x > hi[i][j] { x } else { hi[i][j] };
+                    }
+                }
+            }
+            (lo, hi, finite)
+        },
+    );
+    if finite.contains(&false) {
+        return Err(points.iter().position(|p| !p.is_finite()).unwrap_or(0));
+    }
+    let least = lo.map(|l| {
+        l.iter()
+            .fold(f32::INFINITY, |a, &b| if b < a { b } else { a })
+    });
+    let greatest = hi.map(|h| {
+        h.iter()
+            .fold(f32::NEG_INFINITY, |a, &b| if b > a { b } else { a })
+    });
+    Ok(Aabb3::new(
+        Vec3A::from_array(least),
+        Vec3A::from_array(greatest),
+    ))
+}
+
+/// For each rotation, the least and greatest projections `a_k·p` of the points on its
+/// columns `a_k`, each evaluated in `f64` as `(a_x·x + a_y·y) + a_z·z`: the products of
+/// `f32` values are exact and the two sums round, so each is within `γ(2)·S` of the exact
+/// extreme (`u = 2^-53`, `S = Σ_j |a_j|·max_p |p_j|`). One pass per rotation: the state of
+/// one stays in registers.
+pub(crate) fn projection_ranges<const N: usize>(
+    points: &[Vec3],
+    rotations: [Mat3A; N],
+) -> [(DVec3, DVec3); N] {
+    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    rotations.map(|rotation| {
+        let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3().to_array());
+        let (lo, hi) = sweep(
+            #[inline(always)]
+            || {
+                let mut lo = [[f64::INFINITY; WIDTH]; 3];
+                let mut hi = [[f64::NEG_INFINITY; WIDTH]; 3];
+                // Padding with a point of the set changes no extreme.
+                let (full, tail, _) = blocks(points, pad);
+                for block in full.chain([&tail]) {
+                    let [x, y, z] = columns_f64(block);
+                    for k in 0..3 {
+                        for j in 0..WIDTH {
+                            let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
+                            lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
+                            hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
+                        }
+                    }
+                }
+                (lo, hi)
+            },
+        );
+        let least = lo.map(|l| l.iter().copied().fold(f64::INFINITY, f64::min));
+        let greatest = hi.map(|h| h.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+        (DVec3::from_array(least), DVec3::from_array(greatest))
+    })
+}
+
+/// Blocks per chunk of [`extremal_points`].
+const CHUNK: usize = 32;
+
+/// How many sample directions [`extremal_points`] projects on.
+pub(crate) const DIRECTIONS: usize = 13;
+
+/// The projections of `(x, y, z)` on the sample directions, in this order: the 3
+/// coordinate axes, the 4 cube diagonals `(1, ±1, ±1)` (these 7 are DiTO-14's) and the 6
+/// face diagonals `(1, ±1, 0)`, `(1, 0, ±1)`, `(0, 1, ±1)` (all 13 are EPOS-26's).
+///
+/// Each is the signed sum `x ± y ± z` of its nonzero terms, left to right: the value of the
+/// dot product `(x·n_x + y·n_y) + z·n_z` (up to the sign of a zero), at the cost of 10 sums.
+#[inline(always)]
+pub(crate) fn projections(x: f32, y: f32, z: f32) -> [f32; DIRECTIONS] {
+    let (sum, difference) = (x + y, x - y);
+    [
+        x,
+        y,
+        z,
+        sum + z,
+        sum - z,
+        difference + z,
+        difference - z,
+        sum,
+        difference,
+        x + z,
+        x - z,
+        y + z,
+        y - z,
+    ]
+}
+
+/// An extreme projection found so far: its value, and the points among which its first
+/// point lies (a chunk, or one point of the tail).
+#[derive(Clone, Copy)]
+struct Extreme {
+    value: f32,
+    start: usize,
+    len: usize,
+}
+
+/// What one sweep learns of the points: the extremal points on the sample directions and
+/// the first two moments.
+pub(crate) struct Summary {
+    /// The points of least and greatest projection on each sample direction
+    /// ([`projections`]), as pairs `[min_0, max_0, min_1, max_1, ...]`, the first such
+    /// point on ties.
+    pub extremal: Vec<DVec3>,
+    /// The mean `m`.
+    pub mean: DVec3,
+    /// The covariance `Σ (p − m)(p − m)ᵀ / n`.
+    pub covariance: DMat3,
+}
+
+/// The entries of the upper triangle of a symmetric 3×3 matrix.
+const ENTRIES: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// The [`Summary`] of the points, in one sweep (the points are read once: on large inputs
+/// the sweeps are bound by memory, not arithmetic).
+///
+/// **Extremes.** The lanes keep only the least and greatest values of each chunk of
+/// [`CHUNK`] blocks; a chunk that strictly improves an extreme becomes its chunk, and the
+/// first point of that chunk with the extreme value is found at the end, by evaluating the
+/// same sums one point at a time (the same bits: IEEE operations in the same order).
+///
+/// **Moments.** The sums are taken about the first point `s`, `d = p − s` in `f64` (exact
+/// for points within a factor `2^29` of each other's magnitude): `m = s + Σd/n` and the
+/// covariance is `Σ ddᵀ/n − (Σd/n)(Σd/n)ᵀ`, which cancels only as much as the mean lies off
+/// `s`, a point of the set, not as much as the points lie off the origin.
+pub(crate) fn summary(points: &[Vec3]) -> Summary {
+    let none = |value| Extreme {
+        value,
+        start: 0,
+        len: 0,
+    };
+    let first = points.first().copied().unwrap_or(Vec3::ZERO);
+    let s = first.as_dvec3().to_array();
+    let (mut extremes, mut sum, mut products) = sweep(
+        #[inline(always)]
+        || {
+            let mut best = [[none(f32::INFINITY), none(f32::NEG_INFINITY)]; DIRECTIONS];
+            let mut sum = [[0.0f64; WIDTH]; 3];
+            let mut products = [[0.0f64; WIDTH]; 6];
+            for (c, chunk) in points.chunks_exact(CHUNK * WIDTH).enumerate() {
+                let mut lo = [[f32::INFINITY; WIDTH]; DIRECTIONS];
+                let mut hi = [[f32::NEG_INFINITY; WIDTH]; DIRECTIONS];
+                for block in chunk.chunks_exact(WIDTH) {
+                    let [x, y, z] = columns(block.try_into().expect("chunks of WIDTH"));
+                    for j in 0..WIDTH {
+                        let q = projections(x[j], y[j], z[j]);
+                        for k in 0..DIRECTIONS {
+                            lo[k][j] = if q[k] < lo[k][j] { q[k] } else { lo[k][j] };
+                            hi[k][j] = if q[k] > hi[k][j] { q[k] } else { hi[k][j] };
+                        }
+                    }
+                    let mut d = [[0.0f64; WIDTH]; 3];
+                    for (i, column) in [x, y, z].iter().enumerate() {
+                        for j in 0..WIDTH {
+                            d[i][j] = f64::from(column[j]) - s[i];
+                            sum[i][j] += d[i][j];
+                        }
+                    }
+                    for (e, &(i, k)) in ENTRIES.iter().enumerate() {
+                        for j in 0..WIDTH {
+                            products[e][j] += d[i][j] * d[k][j];
+                        }
+                    }
+                }
+                for k in 0..DIRECTIONS {
+                    let least = lo[k]
+                        .iter()
+                        .fold(f32::INFINITY, |a, &b| if b < a { b } else { a });
+                    let greatest = hi[k]
+                        .iter()
+                        .fold(f32::NEG_INFINITY, |a, &b| if b > a { b } else { a });
+                    let at = |value| Extreme {
+                        value,
+                        start: c * CHUNK * WIDTH,
+                        len: CHUNK * WIDTH,
+                    };
+                    // Strictly better only: the first chunk to reach a value keeps it.
+                    if least < best[k][0].value {
+                        best[k][0] = at(least);
+                    }
+                    if greatest > best[k][1].value {
+                        best[k][1] = at(greatest);
+                    }
+                }
+            }
+            (best, sum, products)
+        },
+    );
+    // The tail, one point at a time: its sums go to lane 0.
+    let project = |p: Vec3| projections(p.x, p.y, p.z);
+    let tail = points.len() - points.len() % (CHUNK * WIDTH);
+    for (i, &p) in points.iter().enumerate().skip(tail) {
+        for (q, [lo, hi]) in project(p).into_iter().zip(&mut extremes) {
+            let here = Extreme {
+                value: q,
+                start: i,
+                len: 1,
+            };
+            if q < lo.value || lo.len == 0 {
+                *lo = here;
+            }
+            if q > hi.value || hi.len == 0 {
+                *hi = here;
+            }
+        }
+        let d = (p.as_dvec3() - DVec3::from_array(s)).to_array();
+        for i in 0..3 {
+            sum[i][0] += d[i];
+        }
+        for (e, &(i, k)) in ENTRIES.iter().enumerate() {
+            products[e][0] += d[i] * d[k];
+        }
+    }
+    let extremal = extremes
+        .iter()
+        .enumerate()
+        .flat_map(|(k, ends)| {
+            ends.map(|e| {
+                let candidates = &points[e.start..e.start + e.len];
+                // The first point of its chunk with the value; an overflowing projection
+                // (`inf` or NaN) may match none, and then any point will do.
+                let first = candidates
+                    .iter()
+                    .find(|&&p| project(p)[k] == e.value)
+                    .or(candidates.first())
+                    .or(points.first());
+                first.map_or(DVec3::ZERO, |p| p.as_dvec3())
+            })
+        })
+        .collect();
+    let n = points.len().max(1) as f64;
+    let offset = DVec3::from_array(sum.map(|x| x.iter().sum::<f64>() / n));
+    let c = products.map(|x| x.iter().sum::<f64>() / n);
+    let raw =
+        DMat3::from_cols_array_2d(&[[c[0], c[1], c[2]], [c[1], c[3], c[4]], [c[2], c[4], c[5]]]);
+    let shift = DMat3::from_cols(offset * offset.x, offset * offset.y, offset * offset.z);
+    Summary {
+        extremal,
+        mean: DVec3::from_array(s) + offset,
+        covariance: raw - shift,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sample directions, as vectors.
+    const VECTORS: [Vec3; DIRECTIONS] = [
+        Vec3::X,
+        Vec3::Y,
+        Vec3::Z,
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(1.0, 1.0, -1.0),
+        Vec3::new(1.0, -1.0, 1.0),
+        Vec3::new(1.0, -1.0, -1.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, -1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+        Vec3::new(0.0, 1.0, -1.0),
+    ];
+
+    /// The signed sums are the dot products with the sample directions, and the extremal
+    /// points are the first points of least and greatest dot product, as a plain loop finds
+    /// them (ties included: the points repeat, and the tail is longer than a block).
+    #[test]
+    fn extremal_points_are_the_first_extremes_of_the_dot_products() {
+        let mut points: Vec<Vec3> = (0..CHUNK * WIDTH * 3 + 13)
+            .map(|i| {
+                let t = i as f32;
+                Vec3::new(
+                    (t * 0.37).sin(),
+                    (t * 0.11).cos(),
+                    ((t * 0.07).sin() * 4.0).round(),
+                )
+            })
+            .collect();
+        points.extend_from_within(..100);
+        for p in &points {
+            for (q, n) in projections(p.x, p.y, p.z).iter().zip(VECTORS) {
+                assert_eq!(*q, p.dot(n), "{p} {n}");
+            }
+        }
+        let expected: Vec<DVec3> = VECTORS
+            .iter()
+            .flat_map(|n| {
+                let first = |better: fn(f32, f32) -> bool| {
+                    let mut best = 0;
+                    for (i, p) in points.iter().enumerate() {
+                        if better(p.dot(*n), points[best].dot(*n)) {
+                            best = i;
+                        }
+                    }
+                    points[best].as_dvec3()
+                };
+                [first(|a, b| a < b), first(|a, b| a > b)]
+            })
+            .collect();
+        assert_eq!(summary(&points).extremal, expected);
+    }
+}
