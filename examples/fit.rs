@@ -1,7 +1,7 @@
 //! Fitting report: for every mesh, each shape × mode's volume as a ratio to the best volume
 //! found for that shape, and its time per 100k vertices; peers (parry3d's OBB and bounding
 //! sphere) and an exhaustive OBB search in the same run. Prints a Markdown table, then the
-//! targets of the fitting issue, each met or missed.
+//! targets of the fitting issues, each met or missed.
 //!
 //! `cargo run --release --example fit [--quick]`: with `--quick`, two small meshes and one
 //! timed run each, to check that the report runs (CI).
@@ -318,17 +318,42 @@ fn check_targets(
     [obb, sphere, capsule]: &[Vec<Row>; 3],
 ) -> Vec<Target> {
     let mut out = Vec::new();
-    let tight_vs_exhaustive = volume_of(obb, "Tight") / volume_of(obb, "exhaustive search");
+    let best_obb = obb.iter().map(|r| r.volume).fold(f64::INFINITY, f64::min);
+    let per_100k =
+        |method: &str| time_of(obb, method).as_secs_f64() * 1e3 * 1e5 / points.len() as f64;
+    // The time targets are per 100k vertices: on a mesh of a few thousand, a fit's fixed
+    // per-call cost (hulls and rectangles of a few dozen points) dominates the scaled
+    // figure, so they are judged on the meshes of at least 10k vertices only.
+    let large = points.len() >= 10_000;
+    let timed = |ms: f64, limit: f64| {
+        if large {
+            (
+                format!("{ms:.3} ms per 100k vertices (<= {limit})"),
+                ms <= limit,
+            )
+        } else {
+            (
+                format!("{ms:.3} ms per 100k vertices (time judged on >= 10k vertices only)"),
+                true,
+            )
+        }
+    };
+    let tight = volume_of(obb, "Tight") / best_obb;
+    let (tight_time, tight_fast_enough) = timed(per_100k("Tight"), 25.0);
     out.push(Target {
-        text: format!("{name}: Tight OBB / exhaustive = {tight_vs_exhaustive:.4} (<= 1.01)"),
-        met: tight_vs_exhaustive <= 1.01,
+        text: format!("{name}: Tight OBB / best = {tight:.4} (<= 1.01), {tight_time}"),
+        met: tight <= 1.01 && tight_fast_enough,
     });
     let fast = volume_of(obb, "Fast");
     let floor = volume_of(obb, "PCA axes, midrange center").min(volume_of(obb, "AABB"));
-    let per_100k = time_of(obb, "Fast").as_secs_f64() * 1e3 * 1e5 / points.len() as f64;
+    let (fast_time, fast_enough) = timed(per_100k("Fast"), 0.5);
     out.push(Target {
-        text: format!("{name}: Fast OBB / min(PCA midrange, AABB) = {:.4} (<= 1), {per_100k:.3} ms per 100k vertices (<= 0.5)", fast / floor),
-        met: fast <= floor && per_100k <= 0.5,
+        text: format!(
+            "{name}: Fast OBB / best = {:.4} (<= 1.15), / min(PCA midrange, AABB) = {:.4} (<= 1), {fast_time}",
+            fast / best_obb,
+            fast / floor
+        ),
+        met: fast <= best_obb * 1.15 && fast <= floor && fast_enough,
     });
     let exact = Sphere::fit(points, Fit::Tight).unwrap();
     let lower = ball_lower_bound(points, exact.center.as_dvec3());
