@@ -58,8 +58,25 @@ fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
 
 /// The hull of distinct points.
 pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
+    let seed = match tetrahedron(points) {
+        Ok(seed) => seed,
+        Err(flat) => return flat,
+    };
+    let kept = outside_extremal_hull(points, seed);
+    // `kept` is sorted and holds the seed.
+    let seed = seed.map(|i| kept.binary_search(&i).unwrap_or(0));
+    let kept: Vec<DVec3> = kept.into_iter().map(|i| points[i]).collect();
+    let mut hull = Quickhull::new(&kept, seed);
+    hull.run();
+    hull.into_hull()
+}
+
+/// Four affinely independent points to start from (the first point, the farthest from
+/// it, the farthest from their line, the farthest from their plane), or the hull of a set
+/// that has none.
+fn tetrahedron(points: &[DVec3]) -> Result<[usize; 4], Hull> {
     let Some(&p0) = points.first() else {
-        return Hull::Point;
+        return Err(Hull::Point);
     };
     let farthest = |key: &dyn Fn(DVec3) -> f64| {
         (0..points.len()).max_by(|&i, &j| key(points[i]).total_cmp(&key(points[j])))
@@ -67,11 +84,11 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
     let i1 = farthest(&|p| p.distance_squared(p0)).unwrap_or(0);
     let p1 = points[i1];
     if p1 == p0 {
-        return Hull::Point;
+        return Err(Hull::Point);
     }
     let axis = (p1 - p0).normalize();
     let Some(i2) = (0..points.len()).find(|&i| !collinear(p0, p1, points[i])) else {
-        return Hull::Segment(axis);
+        return Err(Hull::Segment(axis));
     };
     let i2 = farthest(&|p| (p - p0).cross(axis).length_squared())
         .filter(|&i| !collinear(p0, p1, points[i]))
@@ -81,15 +98,88 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
     // vectors (as for (1e-30, 2e-30, 0), (1e30, 1e30, 0), (-1e30, -1e30, 0)): with no
     // normal to speak of, the set is a segment for the fits' purposes.
     let Some(normal) = (p1 - p0).cross(p2 - p0).try_normalize() else {
-        return Hull::Segment(axis);
+        return Err(Hull::Segment(axis));
     };
     let volume = |p: DVec3| orient3d(coord(p0), coord(p1), coord(p2), coord(p));
     let Some(i3) = farthest(&|p| volume(p).abs()).filter(|&i| volume(points[i]) != 0.0) else {
-        return Hull::Planar(normal);
+        return Err(Hull::Planar(normal));
     };
-    let mut hull = Quickhull::new(points, [0, i1, i2, i3]);
-    hull.run();
-    hull.into_hull()
+    Ok([0, i1, i2, i3])
+}
+
+/// Sample directions for [`outside_extremal_hull`]: the coordinate axes, the cube
+/// diagonals and the face diagonals.
+const DIRECTIONS: [[f64; 3]; 13] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [1.0, 1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 0.0, 1.0],
+    [1.0, 0.0, -1.0],
+    [0.0, 1.0, 1.0],
+    [0.0, 1.0, -1.0],
+];
+
+/// The indices of the points that may be vertices of the hull (Akl–Toussaint): every
+/// point but those strictly inside the hull of the extremal points along [`DIRECTIONS`],
+/// which are not (a point inside the hull of others is no vertex of the hull of all). The
+/// `seed` points are always kept.
+///
+/// The test is a floating-point filter that only ever drops a point it has proven inside:
+/// for a face `(a, b, c)` with `n = (b − a) × (c − a)` and a point `p`, the `f64` value of
+/// `n·(p − a)` is within a few `u = 2^-53` of `|b − a|₁·|c − a|₁·|p − a|₁` of the exact one,
+/// far below the pad `2^-40` times that; a point below every face by more than its pad lies
+/// strictly inside. Inputs too small to gain keep every point.
+fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
+    let all = || (0..points.len()).collect();
+    if points.len() < 64 {
+        return all();
+    }
+    let mut extremal: Vec<usize> = seed.to_vec();
+    for n in DIRECTIONS.map(DVec3::from_array) {
+        let key = |&i: &usize| points[i].dot(n);
+        let by = |a: &usize, b: &usize| key(a).total_cmp(&key(b));
+        extremal.extend((0..points.len()).min_by(by));
+        extremal.extend((0..points.len()).max_by(by));
+    }
+    extremal.sort_unstable();
+    extremal.dedup();
+    let subset: Vec<DVec3> = extremal.iter().map(|&i| points[i]).collect();
+    // The seed is among the extremal points, and affinely independent.
+    let inner_seed = seed.map(|i| extremal.binary_search(&i).unwrap_or(0));
+    let mut inner = Quickhull::new(&subset, inner_seed);
+    inner.run();
+    let Hull::Solid {
+        vertices,
+        triangles,
+    } = inner.into_hull()
+    else {
+        return all();
+    };
+    // Each face: a vertex, its normal, and the pad factor 2^-40·|b − a|₁·|c − a|₁.
+    let faces: Vec<(DVec3, DVec3, f64)> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i]);
+            let (ab, ac) = (b - a, c - a);
+            let pad = 2f64.powi(-40) * ab.abs().element_sum() * ac.abs().element_sum();
+            (a, ab.cross(ac), pad)
+        })
+        .collect();
+    let inside = |p: DVec3| {
+        faces.iter().all(|&(a, n, pad)| {
+            let d = p - a;
+            n.dot(d) < -pad * d.abs().element_sum()
+        })
+    };
+    (0..points.len())
+        .filter(|&i| extremal.binary_search(&i).is_ok() || !inside(points[i]))
+        .collect()
 }
 
 /// The working state: faces with their outside sets, and the directed-edge map.
@@ -283,5 +373,44 @@ mod tests {
         ];
         assert!(matches!(convex_hull(&line), Hull::Segment(_)));
         assert!(matches!(convex_hull(&[DVec3::ONE]), Hull::Point));
+    }
+
+    /// The filter drops no vertex: the hull of a cloud (points on a sphere and inside it,
+    /// one on a segment between two of them) is the hull of all its points.
+    #[test]
+    fn the_extremal_filter_keeps_every_vertex() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut points: Vec<DVec3> = (0..2000)
+            .map(|k| {
+                let p = DVec3::new(next(), next(), next());
+                // On the unit sphere, or in the cube of half-side 0.5 inside it.
+                if k % 3 == 0 { p.normalize() } else { p * 0.5 }
+            })
+            .map(|p| p.as_vec3().as_dvec3())
+            .collect();
+        // Points on the segment between two extremal points lie on the filter's hull.
+        points.push((points[0] + points[1]) * 0.5);
+        let vertices = |hull: Hull| match hull {
+            Hull::Solid { vertices, .. } => {
+                let mut v: Vec<[u64; 3]> = vertices
+                    .iter()
+                    .map(|p| p.to_array().map(f64::to_bits))
+                    .collect();
+                v.sort_unstable();
+                v
+            }
+            _ => panic!("a ball is solid"),
+        };
+        let filtered = vertices(convex_hull(&points));
+        let mut full = Quickhull::new(&points, tetrahedron(&points).expect("a solid"));
+        full.run();
+        assert_eq!(filtered, vertices(full.into_hull()));
+        assert_eq!(filtered.len(), 667, "every point on the sphere");
     }
 }

@@ -13,7 +13,8 @@ use glam::DVec2;
 /// The convex hull, counter-clockwise, without collinear vertices (any order of input).
 pub(crate) fn convex_hull_2d(points: &[DVec2]) -> Vec<DVec2> {
     let mut sorted = points.to_vec();
-    sorted.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    // Unstable is enough: equal keys are equal points, which `dedup` merges.
+    sorted.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     sorted.dedup();
     if sorted.len() < 3 {
         return sorted;
