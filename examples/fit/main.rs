@@ -351,11 +351,13 @@ fn check_targets(
     let (fast_time, fast_enough) = timed(per_100k("Fast"), 0.5);
     out.push(Target {
         text: format!(
-            "{name}: Fast OBB / best = {:.4} (<= 1.15), / min(PCA midrange, AABB) = {:.4} (<= 1), {fast_time}",
+            "{name}: Fast OBB / best = {:.4} (<= 1.15), / min(PCA midrange, AABB) = {:.7} (<= 1 + 1e-6), {fast_time}",
             fast / best_obb,
             fast / floor
         ),
-        met: fast <= best_obb * 1.15 && fast <= floor && fast_enough,
+        // The PCA axes of the points as given and of the distinct points (the reference's)
+        // differ in the last bits on meshes with duplicates: the tests' 1e-6.
+        met: fast <= best_obb * 1.15 && fast <= floor * (1.0 + 1e-6) && fast_enough,
     });
     let exact = Sphere::fit(points, Fit::Tight).unwrap();
     let lower = ball_lower_bound(points, exact.center.as_dvec3());
