@@ -6,7 +6,7 @@ use crate::Aabb3;
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3, Vec3A};
 
-pub(crate) use super::sweep::summary;
+pub(crate) use super::sweep::{Summary, summary};
 
 /// Checks the input and returns its bounding box: an error for no point or a non-finite one.
 pub(crate) fn validate(points: &[Vec3]) -> Result<Aabb3, FitError> {
@@ -17,6 +17,25 @@ pub(crate) fn validate(points: &[Vec3]) -> Result<Aabb3, FitError> {
         index,
         point: points[index].to_array(),
     })
+}
+
+/// Checks the input as [`validate`] does, and returns its [`Summary`] (bounding box
+/// included) from the same sweep.
+pub(crate) fn summarize(points: &[Vec3]) -> Result<Summary, FitError> {
+    if points.is_empty() {
+        return Err(FitError::Empty);
+    }
+    let summary = summary(points);
+    if summary.finite {
+        return Ok(summary);
+    }
+    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+        return Err(FitError::NonFinite {
+            index,
+            point: points[index].to_array(),
+        });
+    }
+    Ok(summary)
 }
 
 /// The exact `f64` value of an `f32` point (the conversion is exact).

@@ -56,11 +56,11 @@ impl Obb3 {
     /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,
     /// [`FitError::Overflow`] when a half-extent would overflow `f32`.
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
-        let bounds = cloud::validate(points)?;
         match fit {
-            Fit::Pca => fit_pca(points, &bounds),
-            Fit::Fast => fit_fast(points, &bounds),
-            Fit::Tight => fit_tight(points, &bounds),
+            Fit::Pca => fit_pca(points, &cloud::validate(points)?),
+            // The fast fit checks the points in its one sweep.
+            Fit::Fast => fit_fast(points, cloud::summarize(points)?),
+            Fit::Tight => fit_tight(points, &cloud::validate(points)?),
         }
     }
 
@@ -315,8 +315,8 @@ const FAST_NORMALS: usize = 48;
 /// DiTO's frames of the first 14 and the face frames of the hull of all 26
 /// ([`face_frames`]) are ranked by the volume they give them, and the best is measured on
 /// every point.
-fn fit_fast(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
-    let summary = cloud::summary(points);
+fn fit_fast(points: &[Vec3], summary: cloud::Summary) -> Result<Obb3, FitError> {
+    let bounds = &summary.bounds;
     let pca = principal_axes(summary.covariance);
     let mut extremal = summary.extremal;
     let dito = dito_frames(&extremal[..14]);
@@ -569,5 +569,5 @@ fn fit_tight(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
         let [obb] = fit_axes(&distinct, bounds, [to_f32(f)], Center::Midrange);
         obb
     });
-    smallest(tight.chain([fit_fast(points, bounds)]))
+    smallest(tight.chain([fit_fast(points, cloud::summary(points))]))
 }

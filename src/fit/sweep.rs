@@ -209,6 +209,10 @@ struct Extreme {
 /// What one sweep learns of the points: the extremal points on the sample directions and
 /// the first two moments.
 pub(crate) struct Summary {
+    /// True when every coordinate is finite; nothing else is meaningful otherwise.
+    pub finite: bool,
+    /// The bounding box (the extremes on the first three directions, the coordinate axes).
+    pub bounds: Aabb3,
     /// The points of least and greatest projection on each sample direction
     /// ([`projections`]), as pairs `[min_0, max_0, min_1, max_1, ...]`, the first such
     /// point on ties.
@@ -234,6 +238,10 @@ const ENTRIES: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2
 /// for points within a factor `2^29` of each other's magnitude): `m = s + Σd/n` and the
 /// covariance is `Σ ddᵀ/n − (Σd/n)(Σd/n)ᵀ`, which cancels only as much as the mean lies off
 /// `s`, a point of the set, not as much as the points lie off the origin.
+///
+/// **Finiteness.** The sums of `d` are finite exactly when every coordinate is: a NaN or an
+/// infinity makes its sum NaN or infinite, and sums of finite `f32` values cannot overflow
+/// `f64`.
 pub(crate) fn summary(points: &[Vec3]) -> Summary {
     let none = |value| Extreme {
         value,
@@ -322,6 +330,11 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             products[e][0] += d[i] * d[k];
         }
     }
+    let finite = sum.iter().flatten().all(|x| x.is_finite());
+    let bounds = Aabb3::new(
+        Vec3A::from_array([0, 1, 2].map(|k| extremes[k][0].value)),
+        Vec3A::from_array([0, 1, 2].map(|k| extremes[k][1].value)),
+    );
     let extremal = extremes
         .iter()
         .enumerate()
@@ -346,6 +359,8 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
         DMat3::from_cols_array_2d(&[[c[0], c[1], c[2]], [c[1], c[3], c[4]], [c[2], c[4], c[5]]]);
     let shift = DMat3::from_cols(offset * offset.x, offset * offset.y, offset * offset.z);
     Summary {
+        finite,
+        bounds,
         extremal,
         mean: DVec3::from_array(s) + offset,
         covariance: raw - shift,
@@ -409,6 +424,22 @@ mod tests {
                 [first(|a, b| a < b), first(|a, b| a > b)]
             })
             .collect();
-        assert_eq!(summary(&points).extremal, expected);
+        let found = summary(&points);
+        assert!(found.finite);
+        assert_eq!(found.extremal, expected);
+        let bounds = Aabb3::from_points(points.iter().map(|&p| p.into()));
+        assert_eq!(
+            (found.bounds.min, found.bounds.max),
+            (bounds.min, bounds.max)
+        );
+        // A NaN in a chunk, an infinity in the tail.
+        let mut bad = points.clone();
+        bad[700].y = f32::NAN;
+        bad[800].x = f32::INFINITY;
+        assert!(!summary(&bad).finite);
+        bad[700].y = 0.0;
+        assert!(!summary(&bad).finite);
+        bad[800].x = 0.0;
+        assert!(summary(&bad).finite);
     }
 }
