@@ -48,8 +48,8 @@ const RADIUS_STEPS: usize = 24;
 
 impl Capsule {
     /// The capsule fitted to `points` with the given effort: [`Fit::Pca`] on the major
-    /// principal axis through the mean; [`Fit::Fast`] on the best axis of the fast box,
-    /// centered by the minimum enclosing circle of the points projected across it;
+    /// principal axis through the mean; [`Fit::Fast`] on the best of the fast box's axes and
+    /// the major principal axis, centered by the minimum enclosing circle of the points projected across it;
     /// [`Fit::Tight`] on a direction optimised from the tight box's axes, with the radius
     /// optimised too. All with the shortest segment (minimal caps), and the radius then
     /// certified from every point.
@@ -197,16 +197,19 @@ fn pca_shape(points: &[Vec3]) -> Shape {
     capped(&distinct, mean, dir, radius)
 }
 
-/// The fast fit: the best of the fast box's three axes, each centered by a minimum
-/// enclosing circle.
+/// The fast fit: the best of the fast box's three axes and the major principal axis (of
+/// the points as given), each centered by a minimum enclosing circle. The box's axes alone
+/// can all miss an elongated set's long direction when its box is turned about it.
 fn fast_shape(points: &[Vec3]) -> Shape {
     let exact_points: Vec<DVec3> = points.iter().map(|&p| exact(p)).collect();
     let frame =
         Obb3::fit(points, Fit::Fast).map_or(glam::DMat3::IDENTITY, |b| b.rotation.as_dmat3());
-    smallest((0..3).filter_map(|k| {
-        let dir = frame.col(k).try_normalize()?;
-        Some(circle_shape(&exact_points, dir))
-    }))
+    let major = principal_axes(cloud::summary(points).covariance).x_axis;
+    smallest(
+        [frame.x_axis, frame.y_axis, frame.z_axis, major]
+            .into_iter()
+            .filter_map(|axis| Some(circle_shape(&exact_points, axis.try_normalize()?))),
+    )
 }
 
 /// The best radius for the axis along `dir`: a golden-section search of the volume over
