@@ -1,14 +1,20 @@
 //! Sweeps: the linear passes of the fits over every input point, in lanes.
 //!
 //! Each sweep is one pass on the running CPU's best backend ([`Backend::detect`]), run
-//! unfused, so that its result does not depend on the backend: the same bits on every CPU,
-//! and the same as one point at a time in the same order of operations.
-//! - [`extremal_points`] runs on the backend's `f32` lane type: each block of points is
-//!   transposed into coordinate columns and projected on every direction at once.
-//! - [`mean`], [`covariance`] and [`projection_ranges`] compute in `f64` on arrays of
-//!   [`WIDTH`] points, compiled inside the backend's dispatch wrapper so that they
-//!   vectorise for its instructions. Sums keep [`WIDTH`] partial sums (point `i` goes to
-//!   sum `i mod WIDTH`), added in order at the end.
+//! unfused, so that its result does not depend on the backend: the same bits on every CPU.
+//! A sweep is plain array code over blocks of [`WIDTH`] points, transposed into coordinate
+//! columns and compiled inside the backend's dispatch wrapper, so that it vectorises for
+//! its instructions; sums keep [`WIDTH`] partial sums (point `i` goes to sum `i mod WIDTH`),
+//! added in order at the end.
+//! - [`bounds`]: the bounding box and the finiteness check, in `f32`.
+//! - [`summary`]: the extremes on 13 sample directions in `f32`, the bounding box, the
+//!   finiteness check and the first two moments in `f64`, in one pass.
+//! - [`projection_ranges`]: a box's projection ranges in `f64`, one pass per box.
+//!
+//! Two lessons of the measurements are kept in the code: a sweep keeps its state in locals
+//! that it returns (conditional writes through captured references do not vectorise), and
+//! reads full blocks in place (a block copied to the stack and read back in another shape
+//! stalls store forwarding).
 
 use crate::Aabb3;
 use crate::simd::{self, Backend, Job, LaneArray};
@@ -165,10 +171,10 @@ pub(crate) fn projection_ranges<const N: usize>(
     })
 }
 
-/// Blocks per chunk of [`extremal_points`].
+/// Blocks per chunk of [`summary`].
 const CHUNK: usize = 32;
 
-/// How many sample directions [`extremal_points`] projects on.
+/// How many sample directions [`summary`] projects on.
 pub(crate) const DIRECTIONS: usize = 13;
 
 /// The projections of `(x, y, z)` on the sample directions, in this order: the 3
