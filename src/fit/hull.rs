@@ -5,13 +5,14 @@
 //! differences neither overflow nor underflow `f64`). A face sees a point only when the point
 //! lies strictly above its plane, so points on a face are dropped, coplanar faces may be
 //! adjacent, and the faces visible from a new point form a disk bounded by one simple cycle
-//! of horizon edges: each new face `(u, v, eye)` is glued to its neighbours through the
-//! directed-edge map alone. Exact predicates make the hull correct on planar, collinear and
+//! of horizon edges: each new face `(u, v, eye)` is glued to the face across its horizon
+//! edge and to the new faces that start at `v` and end at `u`. Faces keep their three
+//! neighbours, so the walks need no map. Exact predicates make the hull correct on planar, collinear and
 //! cospherical input, which is reported as [`Hull::Planar`], [`Hull::Segment`] or
 //! [`Hull::Point`]. The fits use the hull only to choose directions; containment never
 //! depends on it (every fit re-derives its extents from every input point).
 
-use alloc::collections::{BTreeMap, BTreeSet};
+use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::DVec3;
@@ -182,14 +183,18 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
         .collect()
 }
 
-/// The working state: faces with their outside sets, and the directed-edge map.
+/// The working state: faces with their outside sets and their neighbours.
 struct Quickhull<'a> {
     points: &'a [DVec3],
     faces: Vec<[usize; 3]>,
+    /// `neighbors[f][k]`: the face across edge `k` of face `f`, `faces[f][k] → faces[f][k + 1]`
+    /// (it runs the other way).
+    neighbors: Vec<[usize; 3]>,
     alive: Vec<bool>,
     outside: Vec<Vec<usize>>,
-    /// Directed edge `(u, v)` → the face that runs `u → v`.
-    edges: BTreeMap<(usize, usize), usize>,
+    /// `visible[f] == step` marks the faces that the current eye sees.
+    visible: Vec<usize>,
+    step: usize,
 }
 
 impl<'a> Quickhull<'a> {
@@ -206,14 +211,27 @@ impl<'a> Quickhull<'a> {
         let mut hull = Self {
             points,
             faces: Vec::new(),
+            neighbors: Vec::new(),
             alive: Vec::new(),
             outside: Vec::new(),
-            edges: BTreeMap::new(),
+            visible: Vec::new(),
+            step: 0,
         };
         let new_faces: Vec<usize> = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]]
             .into_iter()
             .map(|f| hull.add_face(f))
             .collect();
+        // Each edge's twin runs the other way in another of the four faces.
+        for f in 0..4 {
+            for k in 0..3 {
+                let (u, v) = (hull.faces[f][k], hull.faces[f][(k + 1) % 3]);
+                hull.neighbors[f][k] = (0..4)
+                    .find(|&g| {
+                        (0..3).any(|j| hull.faces[g][j] == v && hull.faces[g][(j + 1) % 3] == u)
+                    })
+                    .unwrap_or(f);
+            }
+        }
         let rest = (0..points.len()).filter(|i| ![a, b, c, d].contains(i));
         hull.assign(rest, &new_faces);
         hull
@@ -221,12 +239,11 @@ impl<'a> Quickhull<'a> {
 
     fn add_face(&mut self, face: [usize; 3]) -> usize {
         let id = self.faces.len();
-        for k in 0..3 {
-            self.edges.insert((face[k], face[(k + 1) % 3]), id);
-        }
         self.faces.push(face);
+        self.neighbors.push([id; 3]);
         self.alive.push(true);
         self.outside.push(Vec::new());
+        self.visible.push(0);
         id
     }
 
@@ -266,52 +283,72 @@ impl<'a> Quickhull<'a> {
                 continue;
             }
             let eye = self.eye(face);
-            let (visible, is_visible) = self.visible_from(face, eye);
+            let visible = self.visible_from(face, eye);
+            // The horizon: edges of visible faces whose neighbour is not visible, with it.
             let mut horizon = Vec::new();
             let mut orphans = Vec::new();
             for &f in &visible {
                 let tri = self.faces[f];
                 for k in 0..3 {
-                    let (u, v) = (tri[k], tri[(k + 1) % 3]);
-                    let across = self.edges.get(&(v, u)).copied();
-                    if across.is_some_and(|g| !is_visible.contains(&g)) {
-                        horizon.push((u, v));
+                    let g = self.neighbors[f][k];
+                    if self.visible[g] != self.step {
+                        horizon.push((tri[k], tri[(k + 1) % 3], g));
                     }
-                }
-                for k in 0..3 {
-                    self.edges.remove(&(tri[k], tri[(k + 1) % 3]));
                 }
                 self.alive[f] = false;
                 orphans.append(&mut self.outside[f]);
             }
+            // A cone of new faces `(u, v, eye)`: across `(u, v)` the horizon face, across
+            // `(v, eye)` the new face that starts at `v`, across `(eye, u)` the one that ends
+            // at `u` (the horizon is one simple cycle).
             let new_faces: Vec<usize> = horizon
-                .into_iter()
-                .map(|(u, v)| self.add_face([u, v, eye]))
+                .iter()
+                .map(|&(u, v, g)| {
+                    let id = self.add_face([u, v, eye]);
+                    self.neighbors[id][0] = g;
+                    if let Some(j) =
+                        (0..3).find(|&j| self.faces[g][j] == v && self.faces[g][(j + 1) % 3] == u)
+                    {
+                        self.neighbors[g][j] = id;
+                    }
+                    id
+                })
                 .collect();
+            for (n, &(u, v, _)) in horizon.iter().enumerate() {
+                let id = new_faces[n];
+                let starts_at = |x: usize| horizon.iter().position(|&(s, _, _)| s == x);
+                let ends_at = |x: usize| horizon.iter().position(|&(_, e, _)| e == x);
+                if let Some(m) = starts_at(v) {
+                    self.neighbors[id][1] = new_faces[m];
+                }
+                if let Some(m) = ends_at(u) {
+                    self.neighbors[id][2] = new_faces[m];
+                }
+            }
             self.assign(orphans.into_iter().filter(|&i| i != eye), &new_faces);
             stack.extend(new_faces);
         }
     }
 
-    /// The faces that see `eye`: a connected disk, found by a walk from `start`; in walk
-    /// order (so the hull is the same on every run) and as a set.
-    fn visible_from(&self, start: usize, eye: usize) -> (Vec<usize>, BTreeSet<usize>) {
-        let (mut order, mut seen) = (vec![start], BTreeSet::from([start]));
+    /// The faces that see `eye`: a connected disk, found by a walk from `start` across
+    /// neighbours, in walk order (so the hull is the same on every run); each is marked
+    /// with a new step number in `visible`.
+    fn visible_from(&mut self, start: usize, eye: usize) -> Vec<usize> {
+        self.step += 1;
+        self.visible[start] = self.step;
+        let mut order = vec![start];
         let mut next = 0;
         while let Some(&f) = order.get(next) {
             next += 1;
-            let tri = self.faces[f];
             for k in 0..3 {
-                if let Some(&g) = self.edges.get(&(tri[(k + 1) % 3], tri[k]))
-                    && !seen.contains(&g)
-                    && self.sees(g, eye)
-                {
-                    seen.insert(g);
+                let g = self.neighbors[f][k];
+                if self.visible[g] != self.step && self.sees(g, eye) {
+                    self.visible[g] = self.step;
                     order.push(g);
                 }
             }
         }
-        (order, seen)
+        order
     }
 
     fn into_hull(self) -> Hull {
