@@ -49,7 +49,8 @@ const RADIUS_STEPS: usize = 24;
 impl Capsule {
     /// The capsule fitted to `points` with the given effort: [`Fit::Pca`] on the major
     /// principal axis through the mean; [`Fit::Fast`] on the best of the fast box's axes and
-    /// the major principal axis, centered by the minimum enclosing circle of the points projected across it;
+    /// the major principal axis, centered by the minimum enclosing circle of the points
+    /// projected across it;
     /// [`Fit::Tight`] on a direction optimised from the tight box's axes, with the radius
     /// optimised too. All with the shortest segment (minimal caps), and the radius then
     /// certified from every point.

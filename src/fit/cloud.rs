@@ -1,5 +1,5 @@
-//! The input point cloud: validation, duplicates, sample directions and a deterministic
-//! shuffle; its moments and extremal points are sweeps in lanes ([`super::sweep`]).
+//! The input point cloud: validation, duplicates and a deterministic shuffle; its bounds,
+//! extremal points and moments are sweeps in lanes ([`super::sweep`]).
 
 use super::FitError;
 use crate::Aabb3;

@@ -2,15 +2,16 @@
 //!
 //! Points are the exact `f64` values of `f32` inputs, and every side-of-plane decision is
 //! Shewchuk's exact `orient3d` (the `robust` crate; exact here, since products of `f32`
-//! differences neither overflow nor underflow `f64`). A face sees a point only when the point
-//! lies strictly above its plane, so points on a face are dropped, coplanar faces may be
-//! adjacent, and the faces visible from a new point form a disk bounded by one simple cycle
-//! of horizon edges: each new face `(u, v, eye)` is glued to the face across its horizon
-//! edge and to the new faces that start at `v` and end at `u`. Faces keep their three
-//! neighbours, so the walks need no map. Exact predicates make the hull correct on planar, collinear and
-//! cospherical input, which is reported as [`Hull::Planar`], [`Hull::Segment`] or
-//! [`Hull::Point`]. The fits use the hull only to choose directions; containment never
-//! depends on it (every fit re-derives its extents from every input point).
+//! differences neither overflow nor underflow `f64`). A face sees a point only when the
+//! point lies strictly above its plane, so points on a face are dropped, coplanar faces may
+//! be adjacent, and the faces visible from a new point form a disk bounded by one simple
+//! cycle of horizon edges: each new face `(u, v, eye)` is glued to the face across its
+//! horizon edge and to the new faces that start at `v` and end at `u`. Faces keep their
+//! three neighbours, so the walks need no map. Exact predicates make the hull correct on
+//! planar, collinear and cospherical input, which is reported as [`Hull::Planar`],
+//! [`Hull::Segment`] or [`Hull::Point`]. The fits use the hull only to choose directions;
+//! containment never depends on it (every fit re-derives its extents from every input
+//! point).
 
 use alloc::collections::BTreeMap;
 use alloc::vec;

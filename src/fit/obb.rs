@@ -519,7 +519,7 @@ fn face_frames(
 }
 
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
-/// [`MAX_FACE_NORMALS`].
+/// `most` of them.
 fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Vec<DVec3> {
     let mut by_direction: BTreeMap<[i64; 3], (f64, DVec3)> = BTreeMap::new();
     for t in triangles {

@@ -115,8 +115,9 @@ fn smallest_center(points: &[Vec3]) -> DVec3 {
 }
 
 /// The fast center: the smallest ball of the extremal points along the 13 sample
-/// directions ([`super::sweep::projections`]; EPOS-26, Larsson 2008), then up to [`FAST_PASSES`] times: find the farthest point from the center,
-/// and if it lies outside, add it to the support set and take the smallest ball again.
+/// directions ([`super::sweep::projections`]; EPOS-26, Larsson 2008), then up to
+/// [`FAST_PASSES`] times: find the farthest point from the center, and if it lies outside,
+/// add it to the support set and take the smallest ball again.
 fn fast_center(points: &[Vec3]) -> DVec3 {
     let mut support: Vec<[f64; 3]> = cloud::summary(points)
         .extremal
