@@ -32,12 +32,10 @@ fn blocks(
     points: &[Vec3],
     pad: Vec3,
 ) -> (impl Iterator<Item = &[Vec3; WIDTH]>, [Vec3; WIDTH], usize) {
-    let full = points.chunks_exact(WIDTH);
-    let rest = full.remainder();
+    let (full, rest) = points.as_chunks::<WIDTH>();
     let mut tail = [pad; WIDTH];
     tail[..rest.len()].copy_from_slice(rest);
-    let full = full.map(|b| <&[Vec3; WIDTH]>::try_from(b).expect("chunks of WIDTH"));
-    (full, tail, rest.len())
+    (full.iter(), tail, rest.len())
 }
 
 /// The coordinate columns of [`WIDTH`] points, in plain indexed loops (closures of
@@ -71,13 +69,13 @@ fn columns_f64(block: &[Vec3; WIDTH]) -> [[f64; WIDTH]; 3] {
 /// backend's dispatch wrapper; it leaves its result in `out`.
 struct Plain<'a, T, F: FnOnce() -> T> {
     f: F,
-    out: &'a mut Option<T>,
+    out: &'a mut T,
 }
 
 impl<T, F: FnOnce() -> T> Job for Plain<'_, T, F> {
     #[inline(always)]
     fn run<L: LaneArray>(self) {
-        *self.out = Some((self.f)());
+        *self.out = (self.f)();
     }
 }
 
@@ -85,10 +83,10 @@ impl<T, F: FnOnce() -> T> Job for Plain<'_, T, F> {
 /// in locals that it returns: conditional writes through captured references do not
 /// vectorise.
 #[inline(always)]
-fn sweep<T>(f: impl FnOnce() -> T) -> T {
-    let mut out = None;
+fn sweep<T: Default>(f: impl FnOnce() -> T) -> T {
+    let mut out = T::default();
     simd::dispatch(Backend::detect(), false, Plain { f, out: &mut out });
-    out.expect("every backend runs the job")
+    out
 }
 
 /// The bounding box of the points, or the index of the first point with a NaN or infinite
@@ -205,7 +203,7 @@ pub(crate) fn projections(x: f32, y: f32, z: f32) -> [f32; DIRECTIONS] {
 
 /// An extreme projection found so far: its value, and the points among which its first
 /// point lies (a chunk, or one point of the tail).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 struct Extreme {
     value: f32,
     start: usize,
@@ -265,8 +263,8 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             for (c, chunk) in points.chunks_exact(CHUNK * WIDTH).enumerate() {
                 let mut lo = [[f32::INFINITY; WIDTH]; DIRECTIONS];
                 let mut hi = [[f32::NEG_INFINITY; WIDTH]; DIRECTIONS];
-                for block in chunk.chunks_exact(WIDTH) {
-                    let [x, y, z] = columns(block.try_into().expect("chunks of WIDTH"));
+                for block in chunk.as_chunks::<WIDTH>().0 {
+                    let [x, y, z] = columns(block);
                     for j in 0..WIDTH {
                         let q = projections(x[j], y[j], z[j]);
                         for k in 0..DIRECTIONS {
