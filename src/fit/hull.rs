@@ -13,6 +13,7 @@
 //! containment never depends on it (every fit re-derives its extents from every input
 //! point).
 
+use crate::math::pow2;
 use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;
@@ -169,7 +170,7 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
         .map(|t| {
             let [a, b, c] = t.map(|i| vertices[i]);
             let (ab, ac) = (b - a, c - a);
-            let pad = 2f64.powi(-40) * ab.abs().element_sum() * ac.abs().element_sum();
+            let pad = pow2(-40) * ab.abs().element_sum() * ac.abs().element_sum();
             (a, ab.cross(ac), pad)
         })
         .collect();
