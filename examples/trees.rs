@@ -8,12 +8,12 @@
 //! `cargo run --release --example trees [--quick]`: with `--quick`, 8 poses per scene and
 //! one timed run each, to check that the report runs (CI).
 
+use bvkit_support::timing::{self, quick};
 use bvkit_support::trimesh;
 
 use std::cell::Cell;
-use std::hint::black_box;
 use std::ops::ControlFlow;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bvkit::Rigid3;
 use bvkit::tree::{Quantized, TriMesh};
@@ -23,26 +23,9 @@ use parry3d::math::Pose;
 use parry3d::query;
 use parry3d::shape::TriMesh as ParryMesh;
 
-/// True with `--quick`.
-fn quick() -> bool {
-    std::env::args().any(|a| a == "--quick")
-}
-
-/// The fastest of repeated runs (at least 3, for at least 0.3 s in all; one with `--quick`).
-fn time<T>(mut f: impl FnMut() -> T) -> Duration {
-    let (mut best, mut total, mut runs) = (Duration::MAX, Duration::ZERO, 0);
-    let (min_runs, min_total) = if quick() {
-        (1, Duration::ZERO)
-    } else {
-        (3, Duration::from_millis(300))
-    };
-    while runs < min_runs || total < min_total {
-        let start = Instant::now();
-        black_box(f());
-        let took = start.elapsed();
-        (best, total, runs) = (best.min(took), total + took, runs + 1);
-    }
-    best
+/// The fastest of repeated calls (at least 3, for at least 0.3 s in all; one with `--quick`).
+fn time<T>(f: impl FnMut() -> T) -> Duration {
+    timing::fastest(Duration::from_millis(300), f)
 }
 
 struct Scene {

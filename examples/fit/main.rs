@@ -9,34 +9,17 @@
 mod capsule_bound;
 
 use bvkit_support::meshes;
+use bvkit_support::timing::{self, quick};
 
 use bvkit::{Capsule, Fit, Obb3, Sphere};
 use glam::{DMat3, DQuat, DVec3, Vec3};
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const MODES: [Fit; 3] = [Fit::Pca, Fit::Fast, Fit::Tight];
 
-/// True with `--quick`.
-fn quick() -> bool {
-    std::env::args().any(|a| a == "--quick")
-}
-
 /// The fastest of repeated calls (at least 3, for at least 0.2 s in all; one with `--quick`).
-fn time<T>(mut f: impl FnMut() -> T) -> Duration {
-    let (mut best, mut total, mut runs) = (Duration::MAX, Duration::ZERO, 0);
-    let (min_runs, min_total) = if quick() {
-        (1, Duration::ZERO)
-    } else {
-        (3, Duration::from_millis(200))
-    };
-    while runs < min_runs || total < min_total {
-        let start = Instant::now();
-        black_box(f());
-        let took = start.elapsed();
-        (best, total, runs) = (best.min(took), total + took, runs + 1);
-    }
-    best
+fn time<T>(f: impl FnMut() -> T) -> Duration {
+    timing::fastest(Duration::from_millis(200), f)
 }
 
 /// One fitted volume (or a reference) of one mesh.

@@ -18,11 +18,7 @@ use crate::oracle::{Bound, Exactly, Problem, affine2, affine3, check, rigid2};
 
 /// The seed of every random sample: the accuracy columns are identical run to run.
 pub const SEED: u64 = 0xb0c5_2026;
-/// True with `--quick`: small sizes and few runs, to check that the report runs (CI); its
-/// timings mean nothing.
-pub fn quick() -> bool {
-    std::env::args().any(|a| a == "--quick")
-}
+pub use bvkit_support::timing::quick;
 /// Boxes of the in-cache batch (inputs and outputs fit in L2).
 pub fn cache() -> usize {
     if quick() { 256 } else { 4096 }

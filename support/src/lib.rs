@@ -15,5 +15,6 @@ pub mod meshes;
 pub mod mxcsr;
 pub mod oracle;
 pub mod sat;
+pub mod timing;
 pub mod trimesh;
 pub mod volumes;
