@@ -66,12 +66,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
     let n = poses.len() as f64;
     let (mut first, mut all) = (0u64, 0u64);
     for &p in &poses {
-        first += a
-            .query(id, &b, p)
-            .unwrap()
-            .visit(|_, _| ControlFlow::Break(()))
-            .1
-            .node_pairs;
+        first += a.query(id, &b, p).unwrap().first_contact().1.node_pairs;
         all += a
             .query(id, &b, p)
             .unwrap()

@@ -118,7 +118,7 @@ fn main() {
             .map(|&p| {
                 a.query(id, &b, p)
                     .expect("finite pose")
-                    .visit(|_, _| ControlFlow::Break(()))
+                    .first_contact()
                     .1
                     .node_pairs
             })

@@ -475,6 +475,30 @@ fn visitor_stops_early() {
     assert_eq!(seen, 3);
 }
 
+#[test]
+fn first_contact_is_the_first_pair_in_descent_order() {
+    let (v, t) = trimesh::torus(1.0, 0.3, 40, 25);
+    let a = TriMesh::new(v, t).unwrap();
+    let (mut hits, mut misses) = (0, 0);
+    for (k, pose) in trimesh::poses(40, 1.2, 21).into_iter().enumerate() {
+        let q = a.query(Rigid3::IDENTITY, &a, pose).unwrap();
+        let all = q.overlapping_triangles();
+        let (first, stats) = q.first_contact();
+        assert_eq!(first, all.first().copied(), "pose {k}");
+        assert_eq!(q.intersects(), first.is_some(), "pose {k}");
+        // It stops at once: no more work than the whole descent.
+        let whole = q.visit(|_, _| ControlFlow::Continue(())).1;
+        assert!(stats.node_pairs <= whole.node_pairs, "pose {k}");
+        if first.is_some() {
+            hits += 1;
+        } else {
+            misses += 1;
+            assert_eq!(stats, whole, "pose {k}");
+        }
+    }
+    assert!(hits > 5 && misses > 5, "{hits} hits, {misses} misses");
+}
+
 // ---------------------------------------------------------------------------------------
 // Layouts, errors, refit.
 

@@ -17,7 +17,7 @@
 //! stalls store forwarding).
 
 use crate::Aabb3;
-use crate::simd::{self, Backend, Job, LaneArray};
+use crate::simd;
 use alloc::vec::Vec;
 use glam::{DMat3, DVec3, Mat3A, Vec3, Vec3A};
 
@@ -65,35 +65,11 @@ fn columns_f64(block: &[Vec3; WIDTH]) -> [[f64; WIDTH]; 3] {
     c
 }
 
-/// A job that ignores the lane type: plain array code, compiled with the features of the
-/// backend's dispatch wrapper; it leaves its result in `out`.
-struct Plain<'a, T, F: FnOnce() -> T> {
-    f: F,
-    out: &'a mut T,
-}
-
-impl<T, F: FnOnce() -> T> Job for Plain<'_, T, F> {
-    #[inline(always)]
-    fn run<L: LaneArray>(self) {
-        *self.out = (self.f)();
-    }
-}
-
-/// Runs `f` on the best backend, unfused (the same bits on every backend). Its state lives
-/// in locals that it returns: conditional writes through captured references do not
-/// vectorise.
-#[inline(always)]
-fn sweep<T: Default>(f: impl FnOnce() -> T) -> T {
-    let mut out = T::default();
-    simd::dispatch(Backend::detect(), false, Plain { f, out: &mut out });
-    out
-}
-
 /// The bounding box of the points, or the index of the first point with a NaN or infinite
 /// coordinate.
 pub(crate) fn bounds(points: &[Vec3]) -> Result<Aabb3, usize> {
     let pad = points.first().copied().unwrap_or(Vec3::ZERO);
-    let (lo, hi, finite) = sweep(
+    let (lo, hi, finite) = simd::plain(
         #[inline(always)]
         || {
             let mut lo = [[f32::INFINITY; WIDTH]; 3];
@@ -143,7 +119,7 @@ pub(crate) fn projection_ranges<const N: usize>(
     let pad = points.first().copied().unwrap_or(Vec3::ZERO);
     rotations.map(|rotation| {
         let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3().to_array());
-        let (lo, hi) = sweep(
+        let (lo, hi) = simd::plain(
             #[inline(always)]
             || {
                 let mut lo = [[f64::INFINITY; WIDTH]; 3];
@@ -254,7 +230,7 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
     };
     let first = points.first().copied().unwrap_or(Vec3::ZERO);
     let s = first.as_dvec3().to_array();
-    let (mut extremes, mut sum, mut products) = sweep(
+    let (mut extremes, mut sum, mut products) = simd::plain(
         #[inline(always)]
         || {
             let mut best = [[none(f32::INFINITY), none(f32::NEG_INFINITY)]; DIRECTIONS];

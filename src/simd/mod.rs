@@ -180,6 +180,31 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     }
 }
 
+/// A job that ignores the lane type: plain array code, compiled with the features of the
+/// backend's dispatch wrapper; it leaves its result in `out`.
+struct Plain<'a, T, F: FnOnce() -> T> {
+    f: F,
+    out: &'a mut T,
+}
+
+impl<T, F: FnOnce() -> T> Job for Plain<'_, T, F> {
+    #[inline(always)]
+    fn run<L: LaneArray>(self) {
+        *self.out = (self.f)();
+    }
+}
+
+/// Runs plain array code `f` inside the dispatch wrapper of the running CPU's best backend
+/// ([`Backend::detect`]), unfused, so that its loops vectorise for that backend's
+/// instructions and give the same bits on every backend. `f` keeps its state in locals that
+/// it returns: conditional writes through captured references do not vectorise.
+#[inline(always)]
+pub(crate) fn plain<T: Default>(f: impl FnOnce() -> T) -> T {
+    let mut out = T::default();
+    dispatch(Backend::detect(), false, Plain { f, out: &mut out });
+    out
+}
+
 // The features enabled here are `Backend::Avx2.features()` (a test checks they agree).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]

@@ -9,7 +9,9 @@ use glam::{DVec3, Vec3A};
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Layout, Ref, Store};
 use super::relative::{QueryError, Relative};
-use super::triangle::{triangles_distance_sq, triangles_intersect};
+use super::triangle::{
+    LANES, TriangleLanes, planes_apart, triangles_distance_sq, triangles_intersect,
+};
 use crate::transform::{Rigid3, Similarity3};
 
 /// What a tree is built over: [`TriMesh`] or [`AabbTree`] (sealed).
@@ -134,21 +136,33 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
 
     /// Calls `leaf(i, j)` for every pair of primitives whose boxes overlap by the
     /// conservative test (a superset of the pairs whose exact boxes overlap or lie within
-    /// the tolerance), until it breaks.
+    /// the tolerance), in descent order, until it breaks. The descent gathers pairs in
+    /// batches, so it may run a few dozen box tests past the pair that breaks.
     pub fn visit_boxes(
         &self,
         mut leaf: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
-        let mut stats = Stats::default();
-        let flow = self.descend(&mut stats, &mut leaf);
-        (flow, stats)
+        self.descend(LANES, |pairs| {
+            for &(i, j) in pairs {
+                leaf(i, j)?;
+            }
+            ControlFlow::Continue(())
+        })
     }
 
+    /// The simultaneous descent: hands the pairs of primitives whose boxes overlap to
+    /// `batch`, in descent order, in batches of at least `flush_at` pairs (the last one
+    /// excepted) and at most [`LANES`], until it breaks.
+    ///
+    /// A step pops a pair and tests the two children of one side against the other side's
+    /// node; inner pairs that pass go on the stack, pairs of primitives to the batch. The
+    /// triangle tests then run on a whole batch at once (a lane filter first).
     fn descend(
         &self,
-        stats: &mut Stats,
-        leaf: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
-    ) -> ControlFlow<()> {
+        flush_at: usize,
+        mut batch: impl FnMut(&[(u32, u32)]) -> ControlFlow<()>,
+    ) -> (ControlFlow<()>, Stats) {
+        let mut stats = Stats::default();
         let rel = &self.relative;
         let (ha, hb) = (self.a.hierarchy(), self.b.hierarchy());
         let box_a = |r: Ref| ha.box_of(r, |i| self.a.primitive_box(i));
@@ -158,22 +172,24 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         let ((ca, ea), (cb, eb)) = (box_a(ha.root), box_b(hb.root));
         stats.node_pairs += 1;
         if !rel.overlaps_ce(ca, ea, cb, eb) || rel.roots_separated(ca, ea, cb, eb, margin) {
-            return ControlFlow::Continue(());
+            return (ControlFlow::Continue(()), stats);
+        }
+        if ha.root.is_primitive() && hb.root.is_primitive() {
+            stats.leaf_pairs += 1;
+            return (batch(&[(ha.root.index(), hb.root.index())]), stats);
         }
         // Each pair on the stack passed its box test; the flag says which side to split,
-        // decided when both boxes were at hand: the node with the larger extent. A pair of
-        // primitives goes to `leaf` at once (only the roots can be one on the stack).
+        // decided when both boxes were at hand: the node with the larger extent.
         let split = |ra: Ref, ea: Vec3A, rb: Ref, eb: Vec3A| {
             !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum())
         };
+        // A step adds at most two pairs to the batch: it is handed over before it can fill.
+        let flush_at = flush_at.clamp(1, LANES - 1);
+        let mut leaves = [(0u32, 0u32); LANES];
+        let mut found = 0;
         let mut stack: Vec<(Ref, Ref, bool)> = Vec::with_capacity(64);
         stack.push((ha.root, hb.root, split(ha.root, ea, hb.root, eb)));
         while let Some((ra, rb, split_a)) = stack.pop() {
-            if ra.is_primitive() && rb.is_primitive() {
-                stats.leaf_pairs += 1;
-                leaf(ra.index(), rb.index())?;
-                continue;
-            }
             if split_a {
                 let (cb, eb) = box_b(rb);
                 for child in ha.layout.children(ra.index()).into_iter().rev() {
@@ -185,8 +201,8 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                     if child.is_primitive() && rb.is_primitive() {
                         if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
                         {
-                            stats.leaf_pairs += 1;
-                            leaf(child.index(), rb.index())?;
+                            leaves[found] = (child.index(), rb.index());
+                            found += 1;
                         }
                     } else {
                         stack.push((child, rb, split(child, ea, rb, eb)));
@@ -203,16 +219,25 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                     if child.is_primitive() && ra.is_primitive() {
                         if !(self.cross_near_leaves && rel.roots_separated(ca, ea, cb, eb, margin))
                         {
-                            stats.leaf_pairs += 1;
-                            leaf(ra.index(), child.index())?;
+                            leaves[found] = (ra.index(), child.index());
+                            found += 1;
                         }
                     } else {
                         stack.push((ra, child, split(ra, ea, child, eb)));
                     }
                 }
             }
+            if found >= flush_at {
+                stats.leaf_pairs += found as u64;
+                let flow = batch(&leaves[..found]);
+                found = 0;
+                if flow.is_break() {
+                    return (flow, stats);
+                }
+            }
         }
-        ControlFlow::Continue(())
+        stats.leaf_pairs += found as u64;
+        (batch(&leaves[..found]), stats)
     }
 }
 
@@ -232,24 +257,75 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
     }
 
     /// Calls `f(i, j)` for every pair of triangles that intersect (or lie within the
-    /// tolerance), until it breaks.
+    /// tolerance), in descent order, until it breaks. The triangle tests run in batches of
+    /// box-overlapping pairs, so the descent may run a few dozen box tests past the pair
+    /// that breaks (see [`Query::first_contact`]).
     pub fn visit(
         &self,
         mut f: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
-        self.visit_boxes(|i, j| {
-            if self.triangles_meet(i, j) {
-                f(i, j)
-            } else {
-                ControlFlow::Continue(())
+        self.descend(LANES, |pairs| self.meet_each(pairs, &mut f))
+    }
+
+    /// Calls `f` on the pairs of `batch` whose triangles meet, in order, until it breaks.
+    fn meet_each(
+        &self,
+        batch: &[(u32, u32)],
+        f: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        if self.tolerance > 0.0 || batch.len() < 4 {
+            for &(i, j) in batch {
+                if self.triangles_meet(i, j) {
+                    f(i, j)?;
+                }
             }
-        })
+            return ControlFlow::Continue(());
+        }
+        let mut a: TriangleLanes = [[[0.0; LANES]; 3]; 3];
+        let mut b: TriangleLanes = [[[0.0; LANES]; 3]; 3];
+        for (l, &(i, j)) in batch.iter().enumerate() {
+            let ta = self.a.triangle_f64(i);
+            let [b0, b1, b2] = self.b.corners(j);
+            let tb = [
+                self.relative.place(b0),
+                self.relative.place(b1),
+                self.relative.place(b2),
+            ];
+            for k in 0..3 {
+                for c in 0..3 {
+                    a[k][c][l] = ta[k][c];
+                    b[k][c][l] = tb[k][c];
+                }
+            }
+        }
+        let apart = planes_apart(&a, &b);
+        for (l, &(i, j)) in batch.iter().enumerate() {
+            if !apart[l] && self.triangles_meet(i, j) {
+                f(i, j)?;
+            }
+        }
+        ControlFlow::Continue(())
     }
 
     /// True when some triangle of `A` meets some triangle of `B` (stops at the first).
     #[must_use]
     pub fn intersects(&self) -> bool {
-        self.visit(|_, _| ControlFlow::Break(())).0.is_break()
+        self.first_contact().0.is_some()
+    }
+
+    /// The first pair `(i, j)` of triangles that meet, in descent order, or `None`, with
+    /// the work done: the descent stops at once, where [`Query::visit`] may run ahead by a
+    /// batch of box tests.
+    #[must_use]
+    pub fn first_contact(&self) -> (Option<(u32, u32)>, Stats) {
+        let mut first = None;
+        let (_, stats) = self.descend(1, |pairs| {
+            self.meet_each(pairs, &mut |i, j| {
+                first = Some((i, j));
+                ControlFlow::Break(())
+            })
+        });
+        (first, stats)
     }
 
     /// Every pair `(i, j)` of triangle ids that meet, in descent order.
