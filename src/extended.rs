@@ -18,10 +18,11 @@
 use glam::Quat;
 
 use crate::method::Rounding;
+use crate::num::{pow2, round_down, round_up, two_sum};
 
 /// Relative bound for the `f64` sum of at most four products, each exact or rounded once,
 /// with room for the rounding of the pad itself: `8·2^-53`.
-const F64_SUM_PAD: f64 = 8.0 / 9_007_199_254_740_992.0;
+const F64_SUM_PAD: f64 = 8.0 * pow2(-53);
 
 /// A map `x ↦ M x + t` in `f64` for the extended path.
 #[derive(Clone, Copy, Debug)]
@@ -102,7 +103,7 @@ impl ExtendedMap<3> {
 }
 
 /// `2^-53`, the unit roundoff of `f64`.
-const F64_ULP: f64 = 1.0 / 9_007_199_254_740_992.0;
+const F64_ULP: f64 = pow2(-53);
 
 /// The box `[lo, hi]` through `map` in extended range.
 #[cold]
@@ -170,15 +171,6 @@ pub(crate) fn transform<const N: usize>(
     (min, max)
 }
 
-/// Knuth's TwoSum in `f64`: `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly.
-#[inline]
-pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let b_virtual = s - a;
-    let a_virtual = s - b_virtual;
-    (s, (a - a_virtual) + (b - b_virtual))
-}
-
 /// True when `a + b` is exact in `f64` (Knuth's TwoSum error term is zero), or infinite.
 #[inline]
 fn is_exact_sum(a: f64, b: f64) -> bool {
@@ -187,18 +179,4 @@ fn is_exact_sum(a: f64, b: f64) -> bool {
         return true; // an infinite face is exact: no finite term changes it
     }
     two_sum(a, b).1 == 0.0
-}
-
-/// The largest `f32` not above `x` (`-inf` below the range).
-#[inline]
-pub(crate) fn round_down(x: f64) -> f32 {
-    let y = x as f32;
-    if f64::from(y) > x { y.next_down() } else { y }
-}
-
-/// The smallest `f32` not below `x` (`+inf` above the range).
-#[inline]
-pub(crate) fn round_up(x: f64) -> f32 {
-    let y = x as f32;
-    if f64::from(y) < x { y.next_up() } else { y }
 }

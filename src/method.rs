@@ -42,7 +42,7 @@
 //! map with those values replaced by zero, which can miss the exact image of the given
 //! values by about `2^-126·(1 + Σ_j |m_ij|)` per axis.
 
-use crate::math::pow2;
+use crate::num::pow2;
 
 /// Unit roundoff of `f32` round-to-nearest: `u = 2^-24`.
 pub const UNIT_ROUNDOFF: f32 = 1.0 / 16_777_216.0;

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3A};
 
 use crate::aabb::Aabb3;
 use crate::error::TransformError;
-use crate::extended::{round_down, round_up};
+use crate::num::{round_down, round_up};
 
 /// Bound on the rounding of a sum of four exact `f64` products, relative to the sum of
 /// their magnitudes: `3·2^-53`, rounded up to `4·2^-53`.

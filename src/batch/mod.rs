@@ -67,6 +67,23 @@ pub enum BatchError {
     TooManyObjects(usize),
 }
 
+impl BatchError {
+    /// `Ok` when `found == expected`, else [`BatchError::LengthMismatch`] for `what`: the one
+    /// place a length check is written.
+    #[inline]
+    pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), Self> {
+        if found == expected {
+            Ok(())
+        } else {
+            Err(Self::LengthMismatch {
+                what,
+                expected,
+                found,
+            })
+        }
+    }
+}
+
 impl fmt::Display for BatchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -441,18 +458,10 @@ fn checked_len<const N: usize>(
     out: &mut impl WriteBoxes<N>,
 ) -> Result<usize, BatchError> {
     let len = local.len()?;
-    let mismatch = |what, found| BatchError::LengthMismatch {
-        what,
-        expected: len,
-        found,
-    };
-    if let Some(n) = xf.len()?.filter(|&n| n != len) {
-        return Err(mismatch("transforms", n));
+    if let Some(n) = xf.len()? {
+        BatchError::check_len("transforms", len, n)?;
     }
-    let out_len = out.len()?;
-    if out_len != len {
-        return Err(mismatch("output", out_len));
-    }
+    BatchError::check_len("output", len, out.len()?)?;
     Ok(len)
 }
 

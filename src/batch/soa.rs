@@ -188,14 +188,10 @@ fn common_len(
     mut columns: impl Iterator<Item = usize>,
 ) -> Result<usize, BatchError> {
     let first = columns.next().unwrap_or(0);
-    match columns.find(|&n| n != first) {
-        None => Ok(first),
-        Some(found) => Err(BatchError::LengthMismatch {
-            what,
-            expected: first,
-            found,
-        }),
+    for found in columns {
+        BatchError::check_len(what, first, found)?;
     }
+    Ok(first)
 }
 
 /// Columns of equal length split into views of `chunk` values each (the last may be

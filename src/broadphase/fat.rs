@@ -3,7 +3,7 @@
 
 use crate::batch::BatchError;
 use crate::lane::{Lane, Vector};
-use crate::math::pow2;
+use crate::num::pow2;
 use crate::{Aabb2, Aabb3};
 use glam::Vec3A;
 

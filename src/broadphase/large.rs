@@ -1,7 +1,7 @@
 //! Large worlds: poses with an `f64` translation, boxes relative to an `f64` origin (see
 //! [`LargePose`]).
 
-use crate::math::pow2;
+use crate::num::{pow2, round_up, two_sum};
 use glam::{Affine3A, DAffine3, DVec3, Quat, Vec3A};
 
 use crate::Aabb3;
@@ -139,7 +139,7 @@ fn offset(b: Aabb3, t: DVec3, origin: DVec3, widen: DVec3) -> Aabb3 {
 
 /// `f32` bounds `lo <= t − o <= hi` of the exact difference of two finite `f64`s.
 fn difference(t: f64, o: f64) -> (f32, f32) {
-    let s = t - o;
+    let (s, e) = two_sum(t, -o);
     if s.is_infinite() {
         // The exact difference overflowed `f64`, so it is beyond `f32::MAX` too.
         return if s > 0.0 {
@@ -148,7 +148,7 @@ fn difference(t: f64, o: f64) -> (f32, f32) {
             (f32::NEG_INFINITY, f32::MIN)
         };
     }
-    enclose(s, two_sum_error(t, -o, s))
+    enclose(s, e)
 }
 
 /// `f32` bounds of the exact value `s + e`, where `s` is the rounded `f64` sum and `e` its
@@ -166,18 +166,12 @@ fn enclose(s: f64, e: f64) -> (f32, f32) {
     (lo, hi)
 }
 
-/// The exact error of `s = RN(a + b)` (Knuth's TwoSum), for finite `s`.
-fn two_sum_error(a: f64, b: f64, s: f64) -> f64 {
-    let bb = s - a;
-    (a - (s - bb)) + (b - bb)
-}
-
 /// The largest `f32` at or below the exact `a + b` (an infinite operand gives itself).
 fn add_down(a: f32, b: f32) -> f32 {
     let (a, b) = (f64::from(a), f64::from(b));
     let s = a + b;
     if s.is_finite() {
-        enclose(s, two_sum_error(a, b, s)).0
+        enclose(s, two_sum(a, b).1).0
     } else {
         s as f32
     }
@@ -188,11 +182,6 @@ fn add_up(a: f32, b: f32) -> f32 {
     -add_down(-a, -b)
 }
 
-/// The smallest `f32` at or above a non-negative `f64` (`+inf` when beyond `f32::MAX`).
-fn round_up(x: f64) -> f32 {
-    enclose(x, 0.0).1
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,7 +189,7 @@ mod tests {
     #[test]
     fn directed_sums_bracket_the_exact_sum() {
         // 1 + 2^-30 is not an f32: the sum rounds to 1, up to the next f32 above.
-        let tiny = crate::math::pow2(-30) as f32;
+        let tiny = crate::num::pow2(-30) as f32;
         assert_eq!(add_down(1.0, tiny), 1.0);
         assert_eq!(add_up(1.0, tiny), 1.0f32.next_up());
         assert_eq!(add_down(1.0, -tiny), 1.0f32.next_down());

@@ -152,12 +152,8 @@ use sealed::Poses;
 impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         match self.len()? {
-            Some(found) if found != len => Err(BatchError::LengthMismatch {
-                what: "poses",
-                expected: len,
-                found,
-            }),
-            _ => Ok(()),
+            Some(found) => BatchError::check_len("poses", len, found),
+            None => Ok(()),
         }
     }
     #[inline(always)]
@@ -246,15 +242,7 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
 
 impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
-        if self.poses.len() == len {
-            Ok(())
-        } else {
-            Err(BatchError::LengthMismatch {
-                what: "poses",
-                expected: len,
-                found: self.poses.len(),
-            })
-        }
+        BatchError::check_len("poses", len, self.poses.len())
     }
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self.poses[i]);
@@ -326,14 +314,7 @@ impl Batch {
         margin.check()?;
         let len = local.len()?;
         poses.check_len(len)?;
-        let fat_len = fat.len()?;
-        if fat_len != len {
-            return Err(BatchError::LengthMismatch {
-                what: "fat boxes",
-                expected: len,
-                found: fat_len,
-            });
-        }
+        BatchError::check_len("fat boxes", len, fat.len()?)?;
         // Indices 0..len must fit in u32; compared in u64, since `u32::MAX + 1` overflows a
         // 32-bit usize.
         if len as u64 > u64::from(u32::MAX) + 1 {

@@ -13,7 +13,7 @@
 //! the fits re-derive the radius of the rounded center from every point
 //! ([`super::bound`]). Recursion depth is at most `D + 1`.
 
-use crate::math::sqrt;
+use crate::num::sqrt;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -25,7 +25,7 @@ pub(crate) struct Ball<const D: usize> {
 }
 
 /// The relative tolerance of the in-ball test.
-const TOLERANCE: f64 = 1.0 / (1u64 << 40) as f64;
+const TOLERANCE: f64 = crate::num::pow2(-40);
 
 fn sub<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
     core::array::from_fn(|i| a[i] - b[i])

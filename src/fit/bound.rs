@@ -17,30 +17,11 @@
 //!
 //! Callers name the roundings of their expression next to each use.
 
-use crate::extended::two_sum;
+use crate::num::{pow2, round_down, round_up, two_sum};
 use glam::DVec3;
 
 /// The relative pad `2^-48`, four times the worst error `γ(8) < 2^-49.9` of the evaluations.
-pub(crate) const SLACK: f64 = 1.0 / (1u64 << 48) as f64;
-
-/// The smallest `f32` at or above `x` (`+inf` above `f32::MAX`).
-#[inline]
-#[must_use]
-pub(crate) fn round_up(x: f64) -> f32 {
-    let nearest = x as f32;
-    if f64::from(nearest) < x {
-        nearest.next_up()
-    } else {
-        nearest
-    }
-}
-
-/// The largest `f32` at or below `x` (`-inf` below `-f32::MAX`).
-#[inline]
-#[must_use]
-pub(crate) fn round_down(x: f64) -> f32 {
-    -round_up(-x)
-}
+pub(crate) const SLACK: f64 = pow2(-48);
 
 /// An `f64` evaluation `value` of a real `x` with `|x − value| ≤ γ(8)·(|value| + scale)`.
 #[derive(Clone, Copy, Debug)]

@@ -8,7 +8,7 @@ use super::obb::{Obb3, tight_frames};
 use super::search::compass_search;
 use super::{Fit, FitError};
 use crate::Aabb3;
-use crate::math::sqrt;
+use crate::num::sqrt;
 use alloc::vec::Vec;
 use core::f64::consts::PI;
 use glam::{DVec3, Vec3, Vec3A};

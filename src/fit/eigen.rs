@@ -8,7 +8,7 @@
 //! eigenvalues) need no special case: the rotations stay orthogonal, so the eigenvectors of
 //! a repeated eigenvalue are some orthonormal basis of its eigenspace.
 
-use crate::math::hypot;
+use crate::num::hypot;
 use glam::DMat3;
 
 /// The cap on Jacobi sweeps (3 rotations each); convergence takes about 5.

@@ -13,7 +13,7 @@
 //! containment never depends on it (every fit re-derives its extents from every input
 //! point).
 
-use crate::math::pow2;
+use crate::num::pow2;
 use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;

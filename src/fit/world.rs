@@ -205,17 +205,10 @@ pub trait BoundingVolume: Shape + Sized {
         rounding: Rounding,
     ) -> Result<(), BatchError> {
         let expected = volumes.len();
-        let mismatch = |what, found| BatchError::LengthMismatch {
-            what,
-            expected,
-            found,
-        };
-        if let Some(found) = xf.len()?.filter(|&n| n != expected) {
-            return Err(mismatch("transforms", found));
+        if let Some(found) = xf.len()? {
+            BatchError::check_len("transforms", expected, found)?;
         }
-        if out.len() != expected {
-            return Err(mismatch("output", out.len()));
-        }
+        BatchError::check_len("output", expected, out.len())?;
         for (k, (volume, o)) in volumes.iter().zip(out.iter_mut()).enumerate() {
             *o = volume.aabb_under(Map::of(&xf.get(k)).as_ref(), rounding);
         }

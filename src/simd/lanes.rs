@@ -148,7 +148,7 @@ impl<const W: usize, const FMA: bool> Lane for F32s<W, FMA> {
         if FMA {
             let mut r = c;
             for k in 0..W {
-                r.0[k] = crate::math::mul_add(self.0[k], b.0[k], c.0[k]);
+                r.0[k] = crate::num::mul_add(self.0[k], b.0[k], c.0[k]);
             }
             r
         } else {

@@ -48,7 +48,7 @@ impl Rigid2 {
     #[inline]
     #[must_use]
     pub fn from_angle_translation(angle: f32, translation: Vec2) -> Self {
-        let (sin, cos) = crate::math::sin_cos(angle);
+        let (sin, cos) = crate::num::sin_cos(angle);
         Self::new(cos, sin, translation)
     }
 

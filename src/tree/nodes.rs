@@ -13,8 +13,7 @@
 //! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
 //! coordinate (`origin + step·c`); the query pad covers that rounding.
 
-use crate::extended::{round_up, two_sum};
-use crate::math::{ceil, pow2, pow2_at_least, round};
+use crate::num::{ceil, pow2, pow2_at_least, round, round_up, two_sum};
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3A};
 

@@ -71,13 +71,12 @@
 //! by the radii plus `‖L‖₁·(δ_a + m·δ_b + |w|) <= ‖L‖₁·P`, and the `f64` evaluation errs by
 //! far less than the second term.
 
-use crate::extended::round_up;
-use crate::math::{pow2, sqrt};
+use crate::num::{pow2, round_up, sqrt};
 use glam::{DMat3, DVec3, Quat, Vec3A};
 
 use crate::transform::{Rigid3, Similarity3};
 
-const U: f64 = 1.0 / 16_777_216.0; // 2^-24
+const U: f64 = pow2(-24);
 
 /// `R(q)` in `f64`, the crate's formula on `q` as stored.
 fn rotation(q: Quat) -> DMat3 {

@@ -16,6 +16,7 @@
 //! three coordinate planes intersect: one of the three projections (along an axis the plane's
 //! normal, or the common line's direction, does not lie across) is injective on them.
 
+use crate::num::pow2;
 use glam::DVec3;
 use robust::{Coord, Coord3D, orient2d, orient3d};
 
@@ -138,8 +139,8 @@ fn segment_triangle(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
 /// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
 /// products could underflow, or not finite) nothing is certain and the exact predicate
 /// decides.
-const TWO_POW_M48: f64 = f64::from_bits((1023 - 48) << 52);
-const TWO_POW_M900: f64 = f64::from_bits((1023 - 900) << 52);
+const TWO_POW_M48: f64 = pow2(-48);
+const TWO_POW_M900: f64 = pow2(-900);
 
 #[inline(always)]
 fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {

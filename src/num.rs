@@ -1,4 +1,5 @@
-//! The float functions `core` lacks: the standard library's where it is linked (feature
+//! Numeric primitives: powers of two, Knuth's TwoSum, directed rounding of `f64` to `f32`,
+//! and the float functions `core` lacks: the standard library's where it is linked (feature
 //! `std`), `libm`'s otherwise. Both are correctly rounded where the callers need it
 //! (`sqrt`, `mul_add`, `ceil`, `round`); `hypot` and `sin_cos` feed no bound.
 
@@ -12,6 +13,32 @@ pub(crate) const fn pow2(k: i32) -> f64 {
 pub(crate) fn pow2_at_least(x: f64) -> f64 {
     let below = f64::from_bits(x.to_bits() & (0x7ff << 52));
     if below < x { below * 2.0 } else { below }
+}
+
+// Directed rounding and exact sums: the one home of each.
+
+/// Knuth's TwoSum in `f64`: `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly.
+#[inline]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let b_virtual = s - a;
+    let a_virtual = s - b_virtual;
+    (s, (a - a_virtual) + (b - b_virtual))
+}
+
+/// The largest `f32` not above `x` (`-inf` below the range): directed rounding of `f64` to
+/// `f32`.
+#[inline]
+pub(crate) fn round_down(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) > x { y.next_down() } else { y }
+}
+
+/// The smallest `f32` not below `x` (`+inf` above the range).
+#[inline]
+pub(crate) fn round_up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) < x { y.next_up() } else { y }
 }
 
 macro_rules! forward {
