@@ -9,9 +9,7 @@ use glam::{DVec3, Vec3A};
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Layout, Ref, Store};
 use super::relative::{QueryError, Relative};
-use super::triangle::{
-    LANES, TriangleLanes, planes_apart, triangles_distance_sq, triangles_intersect,
-};
+use super::triangle::{LANES, TriangleLanes, filter, triangles_distance_sq, triangles_intersect};
 use crate::transform::{Rigid3, Similarity3};
 
 /// What a tree is built over: [`TriMesh`] or [`AabbTree`] (sealed).
@@ -298,9 +296,14 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
                 }
             }
         }
-        let apart = planes_apart(&a, &b);
+        let verdicts = filter(&a, &b);
+        let corners = |t: &TriangleLanes, l: usize| {
+            [0, 1, 2].map(|k| DVec3::new(t[k][0][l], t[k][1][l], t[k][2][l]))
+        };
         for (l, &(i, j)) in batch.iter().enumerate() {
-            if !apart[l] && self.triangles_meet(i, j) {
+            let meet = verdicts.meet[l]
+                || !verdicts.apart[l] && triangles_intersect(&corners(&a, l), &corners(&b, l));
+            if meet {
                 f(i, j)?;
             }
         }
