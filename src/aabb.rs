@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3A};
 
-use crate::transform::{Fields, MAX_FIELDS};
+use crate::fields::{Fields, MAX_FIELDS};
 
 /// An axis-aligned box in 3D, `min <= p <= max`.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -1,9 +1,9 @@
 //! A block of boxes in lanes through a map: the fast kernel for the whole block, and the
 //! mask of the lanes whose result stands. The others go to the extended-range path.
 
+use crate::kernel::MapKernel;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;
-use crate::transform::MapKernel;
 
 /// The boxes `[lo, hi]` through `map` on the fast path, with a lane value that says where
 /// the result stands: 0 where the box is non-empty with no NaN and the result finite,

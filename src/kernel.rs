@@ -8,7 +8,13 @@
 
 use crate::lane::{Axes, Lane};
 use crate::method::{Method, REACH_FLOOR, UNIT_ROUNDOFF};
-use crate::transform::MapKernel;
+
+/// A box through a map in lanes: the kernel of one transform class.
+pub trait MapKernel<V> {
+    /// The fast-path kernel: pure round-to-nearest arithmetic, padded outward when
+    /// asked; its callers check that the box is non-empty and the result finite.
+    fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V);
+}
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.
 #[derive(Clone, Copy, Debug)]

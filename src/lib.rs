@@ -149,6 +149,8 @@ mod block;
 pub mod broadphase;
 mod error;
 mod extended;
+mod fat;
+mod fields;
 mod fit;
 mod kernel;
 mod lane;

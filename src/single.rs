@@ -12,9 +12,11 @@ use crate::aabb::{Aabb2, Aabb3};
 use crate::block;
 use crate::error::TransformError;
 use crate::extended;
+use crate::fields::MAX_FIELDS;
+use crate::kernel::MapKernel;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
-use crate::transform::{Class, MAX_FIELDS, MapKernel, Rigid2, Transform2, Transform3};
+use crate::transform::{Class, Rigid2, Transform2, Transform3};
 
 /// True where glam's `Vec3A` is a SIMD register; elsewhere the scalar path is used.
 const GLAM_SIMD: bool = cfg!(any(

@@ -9,9 +9,10 @@ use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
 use super::{BatchError, Maps, box_lanes, zero_fields};
 use crate::aabb::Aabb3;
 use crate::aabb::Boxes;
+use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::{Class, Fields, MAX_FIELDS};
+use crate::transform::Class;
 use alloc::vec::Vec;
 
 /// Items `i..i + count` of a slice, field `n` of item `k` in lane `k` of `f[n]`.

@@ -9,7 +9,7 @@
 use crate::aabb::Aabb3;
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-use crate::transform::Transform3;
+use crate::transform::{Simd3Job, Transform3};
 
 /// Transforms read as AoS: one per box, or one shared.
 #[derive(Clone, Copy)]
@@ -27,17 +27,6 @@ pub(crate) struct Aos3<'a, T> {
     pub out: &'a mut [Aabb3],
     pub method: Method,
     pub rounding: Rounding,
-}
-
-/// A job over AoS 3D boxes that runs the single-box kernel of its class `T`, which the
-/// generic batch code knows only as a [`Class`](crate::transform::Class): the class's
-/// `run_simd3` hook runs it where `T` is a [`Transform3`].
-pub(crate) trait Simd3Job<T> {
-    /// Runs the job and returns true, or returns false where `backend` keeps its own
-    /// lanes (the scalar reference and `wide`).
-    fn run(self, backend: Backend) -> bool
-    where
-        T: Transform3;
 }
 
 impl<T> Simd3Job<T> for Aos3<'_, T> {

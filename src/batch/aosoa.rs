@@ -7,11 +7,10 @@ use glam::{Affine2, Affine3A};
 use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
 use super::{BatchError, box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::{
-    Class, Fields, MAX_FIELDS, Rigid2, Rigid3, Similarity3, Translation2, Translation3, Trs3,
-};
+use crate::transform::{Class, Rigid2, Rigid3, Similarity3, Translation2, Translation3, Trs3};
 
 /// Eight values of `T` (boxes or transforms), field by field: `fields[n][k]` is field `n`
 /// of value `k`, in the field order of `T` (a box: `min` then `max`; a transform: see its

@@ -43,7 +43,7 @@ pub use soa::{
 };
 
 use crate::aabb::Aabb3;
-pub(crate) use aos3::{Aos3, Maps, Simd3Job};
+pub(crate) use aos3::{Aos3, Maps};
 
 /// Why a batch was refused. Nothing was written.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,7 +60,7 @@ pub enum BatchError {
     /// The backend asked for cannot run on this CPU.
     UnsupportedBackend(Backend),
     /// A broadphase margin is negative, infinite or NaN.
-    InvalidMargin(crate::broadphase::Margin),
+    InvalidMargin(crate::fat::Margin),
     /// A broadphase active set is malformed; the reason is given.
     InvalidActive(&'static str),
     /// More objects than `u32` indices can name.
@@ -223,11 +223,11 @@ use sealed::{ReadBoxes, ReadMaps, WriteBoxes};
 /// Box `(min, max)` lanes from the fields of a box type in lanes.
 #[inline(always)]
 fn box_lanes<L: Copy, const N: usize>(
-    f: &[L; crate::transform::MAX_FIELDS],
+    f: &[L; crate::fields::MAX_FIELDS],
 ) -> (Vector<L, N>, Vector<L, N>) {
     (
-        crate::transform::vector_at(f, 0),
-        crate::transform::vector_at(f, N),
+        crate::fields::vector_at(f, 0),
+        crate::fields::vector_at(f, N),
     )
 }
 
@@ -482,8 +482,8 @@ pub fn transform_slice<T: Transform3>(
 
 /// Lane helpers shared by the layouts.
 #[inline(always)]
-fn zero_fields<L: LaneArray>() -> [L; crate::transform::MAX_FIELDS] {
-    [L::splat(0.0); crate::transform::MAX_FIELDS]
+fn zero_fields<L: LaneArray>() -> [L; crate::fields::MAX_FIELDS] {
+    [L::splat(0.0); crate::fields::MAX_FIELDS]
 }
 
 #[cfg(test)]

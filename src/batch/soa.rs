@@ -7,9 +7,10 @@ use glam::Affine3A;
 use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
 use super::{BatchError, box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::{Class, Fields, MAX_FIELDS};
+use crate::transform::Class;
 
 /// Owned columns of values of `T` (boxes or transforms): `columns[n][k]` is field `n` of
 /// value `k`, in the field order of `T` (see [`Block8`](super::Block8)).

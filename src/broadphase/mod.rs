@@ -39,21 +39,21 @@
 //! # Ok::<(), bvkit::BatchError>(())
 //! ```
 
-mod fat;
 mod large;
 mod moved;
 
 use crate::aabb::Aabb3;
 use crate::batch::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use crate::batch::{Batch, BatchError, BoxSink, BoxSource, Maps, Simd3Job};
+use crate::batch::{Batch, BatchError, BoxSink, BoxSource, Maps};
 use crate::block;
 use crate::extended;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
+use crate::transform::Simd3Job;
 use crate::transform::{Class, Transform3};
 
-pub use fat::Margin;
+pub use crate::fat::Margin;
 pub use large::{LargePose, LargeRigid3};
 pub use moved::Moved;
 
@@ -311,7 +311,9 @@ impl Batch {
         mut fat: impl BoxSink<N>,
         moved: &mut Moved,
     ) -> Result<(), BatchError> {
-        margin.check()?;
+        if !margin.is_valid() {
+            return Err(BatchError::InvalidMargin(margin));
+        }
         let len = local.len()?;
         poses.check_len(len)?;
         BatchError::check_len("fat boxes", len, fat.len()?)?;
@@ -487,7 +489,7 @@ impl<T: Transform3> Chunk<'_, T> {
     #[inline(always)]
     fn one(&self, i: usize, fat: &mut [Aabb3], moved: &mut Moved) {
         let tight = self.local[i].transformed(self.pose(i), self.method, self.rounding);
-        if !fat::inside_aabb3(&tight, &fat[i]) {
+        if !crate::fat::inside_aabb3(&tight, &fat[i]) {
             fat[i] = tight.fattened(self.margin);
             moved.record(i, 1);
         }
@@ -508,7 +510,7 @@ impl<T: Transform3> Chunk<'_, T> {
             let mut left = 0;
             for (k, (l, f)) in local.iter().zip(&*fat).enumerate() {
                 tight[k] = l.transformed(self.pose(base + k), self.method, self.rounding);
-                left |= u32::from(!fat::inside_aabb3(&tight[k], f)) << k;
+                left |= u32::from(!crate::fat::inside_aabb3(&tight[k], f)) << k;
             }
             let mut bits = left;
             while bits != 0 {
@@ -685,7 +687,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
         let (lo, hi) = self.local.load::<L>(i, count);
         let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
-        let outside = fat::outside(min, max, fat_min, fat_max);
+        let outside = crate::fat::outside(min, max, fat_min, fat_max);
         // The common case, every box inside its fat box and standing: one reduction.
         if !(outside + stands).any_nonzero() {
             return;
@@ -760,7 +762,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
     fn redo(&mut self, i: usize, method: Method) -> bool {
         let (lo, hi) = self.local.get(i);
         let tight = self.poses.tight_one(i, lo, hi, method, self.rounding);
-        if fat::inside(tight, self.fat.read().get(i).into()) {
+        if crate::fat::inside(tight, self.fat.read().get(i).into()) {
             return false;
         }
         let (min, max) = self

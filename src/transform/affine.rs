@@ -2,9 +2,9 @@
 
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
-use super::{Class, Fields, MAX_FIELDS, Simd3, Transform2, Transform3, vector_at};
-use crate::batch::Simd3Job;
+use super::{Class, Simd3, Simd3Job, Transform2, Transform3};
 use crate::extended::ExtendedMap;
+use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::AffineLanes;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;

@@ -54,7 +54,7 @@ pub use translation::{Translation2, Translation3};
 
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, vector_at};
+pub(crate) use sealed::{Class, Simd3, Simd3Job};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -84,45 +84,21 @@ pub(crate) mod sealed {
     //! becomes lanes, its kernel and its extended-range form.
 
     use super::*;
-    use crate::batch::Simd3Job;
     use crate::extended::ExtendedMap;
+    use crate::fields::{Fields, MAX_FIELDS};
+    use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
     use crate::simd::Backend;
 
-    /// The most `f32` fields any stored type has (`Affine3A`: 12).
-    pub const MAX_FIELDS: usize = 12;
-
-    /// Fields `k..k + N` as a vector (an indexed loop, always inlined into the loaders).
-    #[inline(always)]
-    pub fn vector_at<L: Copy, const N: usize>(f: &[L; MAX_FIELDS], k: usize) -> Vector<L, N> {
-        let mut v = [f[k]; N];
-        for (i, x) in v.iter_mut().enumerate() {
-            *x = f[k + i];
-        }
-        Vector(v)
-    }
-
-    /// A plain-data type stored as `FIELDS` floats: the unit of the AoSoA and SoA layouts.
-    pub trait Fields: Copy + Send + Sync {
-        /// The number of `f32` fields.
-        const FIELDS: usize;
-        /// `[C; FIELDS]`: one `C` per field (a lane block, a column, …).
-        type Array<C: Send + Sync>: AsRef<[C]> + AsMut<[C]> + Send + Sync;
-        /// The array whose entry `n` is `f(n)`.
-        fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C>;
-        /// The value that pads a partial AoSoA block (the identity, or the empty box).
-        const PADDING: Self;
-        /// The fields, in their fixed order; entries past `FIELDS` are zero.
-        fn to_fields(&self) -> [f32; MAX_FIELDS];
-        /// The value from its fields.
-        fn from_fields(f: &[f32; MAX_FIELDS]) -> Self;
-    }
-
-    /// A box through a map in lanes: the kernel of one transform class.
-    pub trait MapKernel<V> {
-        /// The fast-path kernel: pure round-to-nearest arithmetic, padded outward when
-        /// asked; its callers check that the box is non-empty and the result finite.
-        fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V);
+    /// A job over AoS 3D boxes that runs the single-box kernel of its class `T`, which the
+    /// generic batch code knows only as a [`Class`](crate::transform::Class): the class's
+    /// `run_simd3` hook runs it where `T` is a [`Transform3`].
+    pub trait Simd3Job<T> {
+        /// Runs the job and returns true, or returns false where `backend` keeps its own
+        /// lanes (the scalar reference and `wide`).
+        fn run(self, backend: Backend) -> bool
+        where
+            T: Transform3;
     }
 
     /// A transform class in `N` dimensions.

@@ -7,9 +7,10 @@
 
 use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
-use super::{Class, Fields, MAX_FIELDS, MapKernel, Simd3, Transform3, vector_at};
-use crate::batch::Simd3Job;
+use super::{Class, Simd3, Simd3Job, Transform3};
 use crate::extended::ExtendedMap;
+use crate::fields::{Fields, MAX_FIELDS, vector_at};
+use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;

@@ -2,8 +2,10 @@
 
 use glam::{Affine2, Mat2, Vec2};
 
-use super::{Class, Fields, MAX_FIELDS, MapKernel, Transform2};
+use super::{Class, Transform2};
 use crate::extended::ExtendedMap;
+use crate::fields::{Fields, MAX_FIELDS};
+use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Lane, Vector};
 use crate::method::Method;

@@ -1,7 +1,6 @@
 //! Fat boxes: a tight box grown by a margin and rounded outward, and the test that a tight
 //! box still lies inside one.
 
-use crate::batch::BatchError;
 use crate::lane::{Lane, Vector};
 use crate::num::pow2;
 use crate::{Aabb2, Aabb3};
@@ -33,14 +32,11 @@ impl Margin {
         Self { absolute, relative }
     }
 
-    /// Refuses a margin that is negative, infinite or NaN.
-    pub(crate) fn check(self) -> Result<(), BatchError> {
+    /// True when both fields are finite and non-negative (otherwise the broadphase refuses
+    /// the margin with [`crate::BatchError::InvalidMargin`]).
+    pub(crate) fn is_valid(self) -> bool {
         let ok = |x: f32| x.is_finite() && x >= 0.0;
-        if ok(self.absolute) && ok(self.relative) {
-            Ok(())
-        } else {
-            Err(BatchError::InvalidMargin(self))
-        }
+        ok(self.absolute) && ok(self.relative)
     }
 
     /// The fat box of the tight boxes `[min, max]`, in lanes.
@@ -120,7 +116,7 @@ impl Aabb3 {
     #[inline]
     #[must_use]
     pub fn fattened(&self, margin: Margin) -> Aabb3 {
-        if margin.check().is_err() {
+        if !margin.is_valid() {
             return Aabb3::NAN;
         }
         // On `Vec3A` lanes: per axis the same operations, so the same bits, as in any lanes.
@@ -134,7 +130,7 @@ impl Aabb2 {
     /// A margin that [`Batch::update`](crate::Batch::update) refuses gives [`Aabb2::NAN`].
     #[must_use]
     pub fn fattened(&self, margin: Margin) -> Aabb2 {
-        if margin.check().is_err() {
+        if !margin.is_valid() {
             return Aabb2::NAN;
         }
         let (min, max) =
