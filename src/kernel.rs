@@ -50,7 +50,7 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 
 /// Arvo's abs-matrix method in doubled form: `2c = lo + hi`, `2e = hi − lo`,
 /// `2c' = M·2c + 2t`, `2e' = |M|·2e`, faces `(2c' ∓ 2e') / 2`; padded outward by
-/// `k·u·(S + 2^-80)` when `pad_order` is `Some(k)`.
+/// `k·u·(S + 2^-80)` when `pad_factor` is `Some(k)`.
 ///
 /// Halving last keeps subnormal boxes exact up to the final rounding (halving first
 /// would flush the half-width of a one-ulp subnormal box to zero). Doubling can overflow
@@ -75,7 +75,7 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     a: &AffineLanes<V, N>,
     lo: V,
     hi: V,
-    pad_order: Option<u32>,
+    pad_factor: Option<u32>,
 ) -> (V, V) {
     let center2 = lo + hi;
     let extent2 = hi - lo;
@@ -87,7 +87,7 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
         world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
     }
     let (mut min2, mut max2) = (world_center2 - world_extent2, world_center2 + world_extent2);
-    if let Some(k) = pad_order {
+    if let Some(k) = pad_factor {
         let reach2 = center2.abs() + extent2;
         let mut magnitude2 = t2.abs() + V::splat(2.0 * REACH_FLOOR);
         for j in 0..N {
@@ -210,12 +210,12 @@ pub(crate) fn transform<V: Axes, const N: usize>(
     method: Method,
     outward: bool,
 ) -> (V, V) {
-    let pad_order = outward.then(|| method.outward_pad(N as u32));
+    let pad_factor = outward.then(|| method.outward_factor(N as u32));
     if method == Method::AbsMatrix {
-        return abs_matrix(a, lo, hi, pad_order);
+        return abs_matrix(a, lo, hi, pad_factor);
     }
     let (min, max) = bound(a, lo, hi, method);
-    match pad_order {
+    match pad_factor {
         Some(k) => {
             let pad = outward_pad(a, lo, hi, k);
             (min - pad, max + pad)

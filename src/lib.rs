@@ -38,8 +38,8 @@
 //!
 //! - **It must contain** (a broadphase, culling, continuous collision: anything a box too
 //!   small would make miss): [`Rounding::Outward`]. The result provably contains the exact
-//!   image of the box. In cache it costs 1.4–1.8× Nearest (abs-matrix AoSoA: 2.3 against
-//!   1.6 ns affine, 4.3 against 2.4 rigid); at 4M boxes memory hides it.
+//!   image of the box. In cache it costs more than Nearest; once memory bound the two cost
+//!   the same (`docs/speed.md` and `docs/trade.md` measure both, per CPU).
 //! - **A few ulps are fine** (debug drawing, level of detail, sorting): [`Rounding::Nearest`],
 //!   each face within `γ(n)·S` of the exact face, on either side.
 //! - **The method**: [`Method::AbsMatrix`] on AoSoA blocks, the fastest kernel there for
@@ -49,16 +49,17 @@
 //!
 //! ## 3. The layout: how your data is stored
 //!
-//! [`Batch::transform`] takes every layout through one entry point; only the speed differs
-//! (rigid poses, abs-matrix, Outward):
+//! [`Batch::transform`] takes every layout through one entry point; only the speed differs.
+//! The lane layouts (AoSoA blocks and columns) are the fastest; `docs/speed.md` measures
+//! every layout on the CPU it names.
 //!
-//! | you hold | pass | ns per box |
-//! |---|---|---:|
-//! | one box and its pose | [`Aabb3::transformed`] | 8.6 |
-//! | `Vec<Aabb3>` and `Vec<Rigid3>` | `&local`, `&poses` | 9.2 |
-//! | AoSoA blocks of eight ([`Aabb3x8`], [`Rigid3x8`]) | `&local8`, `&poses8` | 4.3 |
-//! | columns ([`AabbSoa`], [`Soa<Rigid3>`](Soa)) | `&local`, `&poses` | 4.1 |
-//! | one pose for many boxes | `&pose` | not measured |
+//! | you hold | pass |
+//! |---|---|
+//! | one box and its pose | [`Aabb3::transformed`] |
+//! | `Vec<Aabb3>` and `Vec<Rigid3>` | `&local`, `&poses` |
+//! | AoSoA blocks of eight ([`Aabb3x8`], [`Rigid3x8`]) | `&local8`, `&poses8` |
+//! | columns ([`AabbSoa`], [`Rigid3Soa`]) | `&local`, `&poses` |
+//! | one pose for many boxes | `&pose` |
 //!
 //! A broadphase calls [`Batch::update`] instead: the same kernels, and only the fat boxes
 //! whose object left them are rewritten (see [`broadphase`]).

@@ -100,7 +100,7 @@ impl Method {
     /// products, then `(2c' ∓ 2e')/2` (one more rounding): `γ(dims + 3)`.
     #[inline]
     #[must_use]
-    pub const fn nearest_gamma(self, dims: u32) -> u32 {
+    pub const fn nearest_order(self, dims: u32) -> u32 {
         match self {
             Method::Naive | Method::SignSelect => dims + 1,
             Method::AbsMatrix => dims + 3,
@@ -113,8 +113,8 @@ impl Method {
     /// itself, one that absorbs the rounding of the computed `S` and of the pad.
     #[inline]
     #[must_use]
-    pub const fn outward_pad(self, dims: u32) -> u32 {
-        self.nearest_gamma(dims) + 2
+    pub const fn outward_factor(self, dims: u32) -> u32 {
+        self.nearest_order(dims) + 2
     }
 
     /// A short lower-case name, for tables.

@@ -49,9 +49,9 @@ impl Aabb3 {
     ///
     /// - [`Rounding::Outward`]: contains the exact image of every real point of `self`;
     ///   each face within `2·(k·u·S_i + τ·TINY_PAD)` of the exact face, `k` being
-    ///   [`Transform3::nearest_gamma`]`(method) + 2`.
+    ///   [`Transform3::nearest_order`]`(method) + 2`.
     /// - [`Rounding::Nearest`]: each face within `γ(n)·S_i + τ·TINY_ERROR` of the exact
-    ///   face, `n` being [`Transform3::nearest_gamma`]`(method)`.
+    ///   face, `n` being [`Transform3::nearest_order`]`(method)`.
     ///
     /// For an affine map `S_i = |t_i| + sum_j |m_ij|·max(|min_j|, |max_j|)` and `τ = 1`;
     /// the other classes are in [`crate::transform`]. Empty in gives [`Aabb3::EMPTY`];
@@ -78,7 +78,9 @@ impl Aabb3 {
     }
 
     /// [`Aabb3::transformed`] computed in plain `f32`, one component at a time: the
-    /// scalar reference every SIMD path is tested against. Same contract.
+    /// scalar reference every SIMD path is tested against. Same contract. A test hook, not
+    /// part of the documented surface.
+    #[doc(hidden)]
     #[inline]
     #[must_use]
     pub fn transformed_scalar<T: Transform3>(
@@ -128,7 +130,7 @@ impl Aabb2 {
     /// with the guarantee `rounding` gives.
     ///
     /// The bounds of [`Aabb3::transformed`] with `dims = 2` and the order `n` of
-    /// [`Transform2::nearest_gamma`]. glam's `Vec2` has no SIMD form, so this is the
+    /// [`Transform2::nearest_order`]. glam's `Vec2` has no SIMD form, so this is the
     /// scalar path.
     #[inline]
     #[must_use]
@@ -140,7 +142,9 @@ impl Aabb2 {
 
     /// The box through a rigid transform: [`Aabb2::transformed`] on a [`Rigid2`], where
     /// [`Method::SignSelect`] is Eberly's four-case sign branch on `(cos >= 0, sin >= 0)`:
-    /// 8 multiplications, 8 additions, 2 comparisons.
+    /// 8 multiplications, 8 additions, 2 comparisons. A test hook (the same as
+    /// [`Aabb2::transformed`]), not part of the documented surface.
+    #[doc(hidden)]
     #[inline]
     #[must_use]
     pub fn transformed_rigid(&self, xf: &Rigid2, method: Method, rounding: Rounding) -> Aabb2 {

@@ -218,3 +218,28 @@ fn affine2_entry_point() {
     assert!(out.contains(&Aabb2::new(Vec2::new(4.0, 0.0), Vec2::new(5.0, 2.0))));
     assert!((out.min - Vec2::new(4.0, 0.0)).abs().max_element() < 1e-5);
 }
+
+#[test]
+fn rigid3_columns_read_like_the_slice() {
+    use bvkit::{Batch, Rigid3, Rigid3Soa, Rigid3SoaRef};
+    let local: Vec<Aabb3> = (0..11)
+        .map(|i| Aabb3::new(Vec3A::splat(-1.0 - i as f32), Vec3A::splat(0.5 + i as f32)))
+        .collect();
+    let poses: Vec<Rigid3> = (0..11)
+        .map(|i| {
+            let q = Quat::from_rotation_y(0.3 * i as f32);
+            Rigid3::new(q, Vec3A::new(i as f32, -2.0, 0.5))
+        })
+        .collect();
+    // Deterministic: every layout gives the scalar reference's bits (by default the AoS
+    // path runs the single-box kernel, the columns the lanes, which may fuse).
+    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward).deterministic();
+    let mut from_slice = vec![Aabb3::EMPTY; local.len()];
+    batch.transform(&local, &poses, &mut from_slice).unwrap();
+    let columns: Rigid3Soa = Rigid3Soa::from_slice(&poses);
+    let view: Rigid3SoaRef<'_> = columns.view();
+    let mut from_columns = vec![Aabb3::EMPTY; local.len()];
+    batch.transform(&local, view, &mut from_columns).unwrap();
+    assert_eq!(from_columns, from_slice);
+    assert!(from_slice.iter().all(|b| b.is_valid() && !b.is_empty()));
+}

@@ -91,7 +91,7 @@ macro_rules! case3 {
                 (b.min.to_array(), b.max.to_array())
             }
             fn order(method: Method) -> u32 {
-                <$T as Transform3>::nearest_gamma(method)
+                <$T as Transform3>::nearest_order(method)
             }
             fn single(b: &Aabb3, xf: &$T, m: Method, r: Rounding) -> Vec<(&'static str, Aabb3)> {
                 vec![
@@ -131,7 +131,7 @@ macro_rules! case2 {
                 (b.min.to_array(), b.max.to_array())
             }
             fn order(method: Method) -> u32 {
-                <$T as Transform2>::nearest_gamma(method)
+                <$T as Transform2>::nearest_order(method)
             }
             fn single(b: &Aabb2, xf: &$T, m: Method, r: Rounding) -> Vec<(&'static str, Aabb2)> {
                 vec![("single", b.transformed(xf, m, r))]

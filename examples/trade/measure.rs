@@ -699,7 +699,7 @@ fn class3<T: Transform3, P: Exactly<3>, const F: usize>(
     m.roofline(Layout::Aosoa, t);
     for k @ (method, rounding) in kernels() {
         m.progress.stage(&kernel_stage(class, k));
-        let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+        let bound = Bound::of_order(T::nearest_order(method), rounding);
         let batch = Batch::new(method, rounding).on(best).expect("detected");
         let mut so = vec![Aabb3::EMPTY; sb.len()];
         batch.transform(&sb, &sx, &mut so).expect("lengths");
@@ -857,7 +857,7 @@ pub fn classes2(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     for k @ (method, rounding) in kernels() {
         progress.stage(&kernel_stage("2D", k));
         let b2 = Bound::documented(method, rounding, 2);
-        let bt = Bound::of_order(Translation2::nearest_gamma(method), rounding);
+        let bt = Bound::of_order(Translation2::nearest_order(method), rounding);
         let (rigid_judged, affine_judged, translation_judged) = (
             (&rigid_sample[..], &rb[..], &rx[..]),
             (&affine_sample[..], &ab[..], &ax[..]),

@@ -133,7 +133,7 @@ fn layouts3<T: Transform3, P: Exactly<3>>(
     inputs: impl Fn(&P) -> (Aabb3, T),
     extra: (u8, usize, bool, bool),
 ) {
-    let bound = |m| bound_of(T::nearest_gamma(m), batch.rounding);
+    let bound = |m| bound_of(T::nearest_order(m), batch.rounding);
     let b: Bound = bound(batch.method);
     let (local, xfs): (Vec<Aabb3>, Vec<T>) = ps.iter().map(inputs).unzip();
     let n = ps.len();
@@ -257,7 +257,7 @@ fuzz_target!(|data: &[u8]| {
             if c == 5 {
                 let (l, x): (Vec<_>, Vec<_>) = ps.iter().map(affine2).unzip();
                 batch.transform(&l, &x, &mut out).unwrap();
-                let b = bound_of(glam::Affine2::nearest_gamma(method), rounding);
+                let b = bound_of(glam::Affine2::nearest_order(method), rounding);
                 for (p, o) in ps.iter().zip(&out) {
                     assert_contract(p, o.min.to_array(), o.max.to_array(), b, &what);
                 }
@@ -265,7 +265,7 @@ fuzz_target!(|data: &[u8]| {
                 let rigid: Vec<_> = ps.iter().map(rigid2).collect();
                 let (l, x): (Vec<_>, Vec<_>) = rigid.iter().map(|(_, b, x)| (*b, *x)).unzip();
                 batch.transform(&l, &x, &mut out).unwrap();
-                let b = bound_of(bvkit::Rigid2::nearest_gamma(method), rounding);
+                let b = bound_of(bvkit::Rigid2::nearest_order(method), rounding);
                 for ((p, _, _), o) in rigid.iter().zip(&out) {
                     assert_contract(p, o.min.to_array(), o.max.to_array(), b, &what);
                 }
@@ -281,7 +281,7 @@ fuzz_target!(|data: &[u8]| {
                     })
                     .unzip();
                 batch.transform(&l, &x, &mut out).unwrap();
-                let b = bound_of(bvkit::Translation2::nearest_gamma(method), rounding);
+                let b = bound_of(bvkit::Translation2::nearest_order(method), rounding);
                 for (p, o) in ps.iter().zip(&out) {
                     assert_contract(p, o.min.to_array(), o.max.to_array(), b, &what);
                 }

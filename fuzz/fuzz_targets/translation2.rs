@@ -12,7 +12,7 @@ fuzz_target!(|data: &[u8]| {
     let (b, xf) = (affine2(&p).0, Translation2(Vec2::from_array(p.t)));
     for method in Method::ALL {
         for rounding in Rounding::ALL {
-            let bound = bound_of(Translation2::nearest_gamma(method), rounding);
+            let bound = bound_of(Translation2::nearest_order(method), rounding);
             let out = b.transformed(&xf, method, rounding);
             assert_contract(&p, out.min.to_array(), out.max.to_array(), bound, "single");
         }

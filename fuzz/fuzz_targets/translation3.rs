@@ -12,7 +12,7 @@ fuzz_target!(|data: &[u8]| {
     let (b, xf) = (bvkit_fuzz::affine3(&p).0, Translation3(Vec3A::from_array(p.t)));
     for method in Method::ALL {
         for rounding in Rounding::ALL {
-            let bound = bound_of(Translation3::nearest_gamma(method), rounding);
+            let bound = bound_of(Translation3::nearest_order(method), rounding);
             let out = b.transformed(&xf, method, rounding);
             assert_contract(&p, out.min.to_array(), out.max.to_array(), bound, "simd");
             let out = b.transformed_scalar(&xf, method, rounding);

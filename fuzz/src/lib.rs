@@ -191,7 +191,7 @@ pub fn bound(method: Method, rounding: Rounding, dims: u32) -> Bound {
     Bound::documented(method, rounding, dims)
 }
 
-/// The bound of a class of order `n` (its `nearest_gamma(method)`).
+/// The bound of a class of order `n` (its `nearest_order(method)`).
 pub fn bound_of(n: u32, rounding: Rounding) -> Bound {
     Bound::of_order(n, rounding)
 }

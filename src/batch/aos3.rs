@@ -1,10 +1,10 @@
 //! The AoS path of 3D boxes: each box as glam stores it, through the single-box kernel.
 //!
 //! Gathering AoS boxes and transforms into one-field-per-register lanes costs a shuffle per
-//! field per box, more than the kernel itself (measured 7.2 against 3.2 ns per box for
-//! affine maps). So `&[Aabb3]` to `&mut [Aabb3]`, with AoS or shared transforms, runs
-//! [`Aabb3::transformed`] on every box, on glam's `Vec3A`: the same bits as the single-box
-//! calls on every SIMD backend (never fused on a default build), and the same contract.
+//! field per box, more than the kernel itself (measured in `docs/speed.md`). So `&[Aabb3]`
+//! to `&mut [Aabb3]`, with AoS or shared transforms, runs [`Aabb3::transformed`] on every
+//! box, on glam's `Vec3A`: the same bits as the single-box calls on every SIMD backend
+//! (never fused on a default build), and the same contract.
 
 use crate::aabb::Aabb3;
 use crate::method::{Method, Rounding};

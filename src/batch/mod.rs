@@ -31,7 +31,7 @@ use crate::extended;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::{Class, Transform3};
+use crate::transform::Class;
 
 pub use aosoa::{
     Aabb2x8, Aabb3x8, Affine2x8, Affine3x8, Block8, Rigid2x8, Rigid3x8, Similarity3x8,
@@ -39,7 +39,7 @@ pub use aosoa::{
 };
 pub use soa::{
     Aabb2Soa, Aabb2SoaMut, Aabb2SoaRef, AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef,
-    Soa, SoaMut, SoaRef,
+    Rigid3Soa, Rigid3SoaRef, Soa, SoaMut, SoaRef,
 };
 
 use crate::aabb::Aabb3;
@@ -351,9 +351,8 @@ impl Batch {
     /// Outputs larger than this many bytes of box fields (32 MiB: about 1.4M 3D boxes,
     /// beyond the last-level cache of most CPUs) are written past the caches when they are
     /// AoSoA blocks: non-temporal stores of whole blocks, then a store fence. The bits are
-    /// the same; at 4M affine boxes abs-matrix Nearest measured 4.15 against 5.16 ns per
-    /// box with them. A consumer that reads the boxes back gains nothing from them staying
-    /// in a cache they do not fit.
+    /// the same, and large batches run faster (`docs/speed.md`). A consumer that reads the
+    /// boxes back gains nothing from them staying in a cache they do not fit.
     pub const NON_TEMPORAL_BYTES: usize = 32 << 20;
 
     /// A batch on the fastest backend of this CPU ([`Backend::detect`]).
@@ -463,21 +462,6 @@ fn checked_len<const N: usize>(
     }
     BatchError::check_len("output", len, out.len()?)?;
     Ok(len)
-}
-
-/// `out[k] = local[k]` through `xf[k]` for every `k`, on the fastest backend of this CPU.
-///
-/// # Errors
-/// [`BatchError::LengthMismatch`] unless all three slices have the same length; `out` is
-/// then untouched.
-pub fn transform_slice<T: Transform3>(
-    local: &[Aabb3],
-    xf: &[T],
-    out: &mut [Aabb3],
-    method: Method,
-    rounding: Rounding,
-) -> Result<(), BatchError> {
-    Batch::new(method, rounding).transform(local, xf, out)
 }
 
 /// Lane helpers shared by the layouts.

@@ -10,7 +10,7 @@ use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::Class;
+use crate::transform::{Class, Rigid3};
 
 /// Owned columns of values of `T` (boxes or transforms): `columns[n][k]` is field `n` of
 /// value `k`, in the field order of `T` (see [`Block8`](super::Block8)).
@@ -47,6 +47,10 @@ pub type Aabb2SoaMut<'a> = SoaMut<'a, Aabb2>;
 pub type Affine3Soa = Soa<Affine3A>;
 /// Borrowed 3D affine transform columns.
 pub type Affine3SoaRef<'a> = SoaRef<'a, Affine3A>;
+/// Owned rigid transforms as seven columns (the quaternion, then the translation).
+pub type Rigid3Soa = Soa<Rigid3>;
+/// Borrowed rigid transform columns.
+pub type Rigid3SoaRef<'a> = SoaRef<'a, Rigid3>;
 
 impl<T: Fields> Clone for Soa<T> {
     fn clone(&self) -> Self {

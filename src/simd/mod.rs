@@ -72,10 +72,9 @@ impl Backend {
     /// The fastest supported backend, detected on first use and cached (without `std`:
     /// the fastest the build's target features guarantee).
     ///
-    /// AVX2+FMA comes first: on the AVX-512 machine it was measured on (an AMD EPYC VM),
-    /// the 16-lane instantiation ran 1.4–2× slower than the 8-lane one (AoSoA, 1K boxes:
-    /// 2.5–4.1 against 1.5–2.2 ns per box), so [`Backend::Avx512`] is only used when forced
-    /// with [`crate::Batch::on`] until its lanes are tuned.
+    /// AVX2+FMA comes first: the 16-lane instantiation measured slower than the 8-lane one
+    /// on AVX-512 machines (`docs/batch.md`), so [`Backend::Avx512`] is only used when
+    /// forced with [`crate::Batch::on`] until its lanes are tuned.
     #[must_use]
     pub fn detect() -> Backend {
         let fastest = || {

@@ -55,7 +55,7 @@ impl Class<3> for Affine3A {
         )
     }
     fn order(method: Method) -> u32 {
-        method.nearest_gamma(3)
+        method.nearest_order(3)
     }
 }
 
@@ -109,7 +109,7 @@ impl Class<2> for Affine2 {
         ExtendedMap::exact([[f[0], f[1]], [f[2], f[3]]], [f[4], f[5]])
     }
     fn order(method: Method) -> u32 {
-        method.nearest_gamma(2)
+        method.nearest_order(2)
     }
 }
 

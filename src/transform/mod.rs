@@ -20,8 +20,8 @@
 //!
 //! Every bound has the form of [`crate::method`]: Nearest faces within
 //! `γ(n)·S_i + τ·TINY_ERROR`, Outward faces containing the exact face and within twice the
-//! pad `(n + 2)·u·S_i + τ·TINY_PAD`, where `n` is [`Transform3::nearest_gamma`]
-//! ([`Transform2::nearest_gamma`]) and the magnitude `S_i` and the factor `τ` are:
+//! pad `(n + 2)·u·S_i + τ·TINY_PAD`, where `n` is [`Transform3::nearest_order`]
+//! ([`Transform2::nearest_order`]) and the magnitude `S_i` and the factor `τ` are:
 //!
 //! - affine maps and [`Rigid2`]: `S_i = |t_i| + Σ_j |m_ij|·max(|lo_j|, |hi_j|)`, `τ = 1`;
 //! - translations: `S_i = |t_i| + max(|lo_i|, |hi_i|)`, `τ = 1`, `n = 1` (one rounding);
@@ -65,7 +65,7 @@ pub trait Transform3: Simd3 {
     /// The order `n` of this class's Nearest bound `γ(n)·S + τ·TINY_ERROR` under `method`
     /// (see the [module docs](crate::transform)); the Outward pad is `(n + 2)·u·S + τ·TINY_PAD`.
     #[must_use]
-    fn nearest_gamma(method: Method) -> u32 {
+    fn nearest_order(method: Method) -> u32 {
         <Self as Class<3>>::order(method)
     }
 }
@@ -74,7 +74,7 @@ pub trait Transform3: Simd3 {
 pub trait Transform2: Class<2> {
     /// The order `n` of this class's Nearest bound `γ(n)·S + τ·TINY_ERROR` under `method`.
     #[must_use]
-    fn nearest_gamma(method: Method) -> u32 {
+    fn nearest_order(method: Method) -> u32 {
         <Self as Class<2>>::order(method)
     }
 }

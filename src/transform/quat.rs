@@ -214,7 +214,7 @@ impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatLanes<V, SCALED> {
 
 /// The method's order plus 3 for the rounding of `R(q)`, plus 1 for the scaled box.
 const fn quat_gamma(method: Method, scaled: bool) -> u32 {
-    method.nearest_gamma(3) + 3 + scaled as u32
+    method.nearest_order(3) + 3 + scaled as u32
 }
 
 /// The lanes of a quaternion class whose fields start `[qx, qy, qz, qw, tx, ty, tz]`.

@@ -118,7 +118,7 @@ impl<L: Lane> MapKernel<Vector<L, 2>> for Rigid2Lanes<L> {
         let (min, max) = kernel::sign_branch_rigid2(cos, sin, self.t, lo.0, hi.0);
         let (min, max) = (Vector(min), Vector(max));
         if outward {
-            let pad = kernel::outward_pad(&a, lo, hi, method.outward_pad(2));
+            let pad = kernel::outward_pad(&a, lo, hi, method.outward_factor(2));
             (min - pad, max + pad)
         } else {
             (min, max)
@@ -161,7 +161,7 @@ impl Class<2> for Rigid2 {
         ExtendedMap::exact([[c, s], [-s, c]], self.translation.to_array())
     }
     fn order(method: Method) -> u32 {
-        method.nearest_gamma(2)
+        method.nearest_order(2)
     }
 }
 

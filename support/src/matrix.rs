@@ -206,7 +206,7 @@ fn cell3<T: Transform3, P: Exactly<3>>(
     method: Method,
     rounding: Rounding,
 ) {
-    let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+    let bound = Bound::of_order(T::nearest_order(method), rounding);
     let (local, xfs): (Vec<Aabb3>, Vec<T>) = ps.iter().map(inputs).unzip();
     for (k, p) in ps.iter().enumerate() {
         let o = local[k].transformed(&xfs[k], method, rounding);
@@ -240,7 +240,7 @@ fn cell2<T: Transform2>(
     method: Method,
     rounding: Rounding,
 ) {
-    let bound = Bound::of_order(T::nearest_gamma(method), rounding);
+    let bound = Bound::of_order(T::nearest_order(method), rounding);
     let (local, xfs): (Vec<Aabb2>, Vec<T>) = ps.iter().map(inputs).unzip();
     for (k, p) in ps.iter().enumerate() {
         let o = local[k].transformed(&xfs[k], method, rounding);

@@ -493,11 +493,11 @@ impl Bound {
     pub fn documented(method: Method, rounding: Rounding, dims: u32) -> Bound {
         match rounding {
             Rounding::Nearest => Bound::Nearest {
-                gamma_n: method.nearest_gamma(dims),
+                gamma_n: method.nearest_order(dims),
                 tiny: f64::from(TINY_ERROR),
             },
             Rounding::Outward => Bound::Outward {
-                k: method.outward_pad(dims),
+                k: method.outward_factor(dims),
                 tiny: f64::from(TINY_PAD),
             },
         }
