@@ -128,50 +128,26 @@ fn segment_triangle(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
     !(s.contains(&1) && s.contains(&-1))
 }
 
-/// The signs of `u`'s vertices against the plane of `t`, from `n·(p − t₀)` with
-/// `n = (t₁ − t₀) × (t₂ − t₀)` in `f64`, or `None` when one of them is not certain.
-///
-/// The filter: each of the six products `±e₁·e₂·w` of the determinant carries at most 9
-/// roundings (three differences, the cross product's products and difference, the dot
-/// product's products and sums), so the computed value errs by at most
-/// `γ(9)·perm < 2^-49.7·perm` with `perm` the sum of their absolute values; `perm` is itself
-/// computed with at most 6 roundings, so `2^-48·perm` bounds the error. A sign is certain when
-/// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
-/// products could underflow, or not finite) nothing is certain and the exact predicate
-/// decides.
+/// The filter's relative error bound and the bottom of its range (see [`orientation`]).
 const TWO_POW_M48: f64 = pow2(-48);
 const TWO_POW_M900: f64 = pow2(-900);
 
+/// The signs of `u`'s vertices against the plane of `t` ([`orientation`] of each), or
+/// `None` when one of them is not certain.
 #[inline(always)]
 fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
-    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-    let n = e1.cross(e2);
-    let na = DVec3::new(
-        (e1.y * e2.z).abs() + (e1.z * e2.y).abs(),
-        (e1.z * e2.x).abs() + (e1.x * e2.z).abs(),
-        (e1.x * e2.y).abs() + (e1.y * e2.x).abs(),
-    );
+    let [t0, t1, t2] = t.map(|v| v.to_array());
     let mut signs = [0i8; 3];
-    for (k, p) in u.iter().enumerate() {
-        let w = *p - t[0];
-        let value = n.dot(w);
-        let perm = na.dot(w.abs());
-        if !(TWO_POW_M900..f64::INFINITY).contains(&perm) {
-            return None;
-        }
-        let bound = perm * TWO_POW_M48;
-        if value > bound {
-            signs[k] = 1;
-        } else if value < -bound {
-            signs[k] = -1;
-        } else {
+    for (sign, p) in signs.iter_mut().zip(u) {
+        *sign = orientation(t0, t1, t2, p.to_array()).of();
+        if *sign == 0 {
             return None;
         }
     }
     Some(signs)
 }
 
-/// Triangle pairs per batch of the lane filter ([`planes_apart`]).
+/// Triangle pairs per batch of the lane filter ([`filter`]).
 pub(crate) const LANES: usize = 32;
 
 /// Triangles in lanes: coordinate `c` of corner `k` of the triangle in lane `l` at
@@ -221,16 +197,8 @@ pub(crate) fn filter(a: &TriangleLanes, b: &TriangleLanes) -> Verdicts {
                 let tb = [corner(b, 0), corner(b, 1), corner(b, 2)];
                 let signs = |s: &[[Sign; LANES]; 3]| [s[0][l].of(), s[1][l].of(), s[2][l].of()];
                 let (sa, sb) = (signs(&sa), signs(&sb));
-                let (i, j) = (lone(sa), lone(sb));
-                let (p1, mut q1, mut r1) = (ta[i], ta[(i + 1) % 3], ta[(i + 2) % 3]);
-                let (p2, mut q2, mut r2) = (tb[j], tb[(j + 1) % 3], tb[(j + 2) % 3]);
-                if sa[i] < 0 {
-                    core::mem::swap(&mut q2, &mut r2);
-                }
-                if sb[j] < 0 {
-                    core::mem::swap(&mut q1, &mut r1);
-                }
-                let (o1, o2) = (orientation(p1, q1, p2, q2), orientation(p1, r1, r2, p2));
+                let [[a0, a1, a2, a3], [b0, b1, b2, b3]] = crossing_corners(ta, tb, sa, sb);
+                let (o1, o2) = (orientation(a0, a1, a2, a3), orientation(b0, b1, b2, b3));
                 v.apart[l] = o1.above | o2.above;
                 v.meet[l] = o1.below & o2.below;
             }
@@ -270,8 +238,17 @@ impl Sign {
     }
 }
 
-/// The sign of `O(t₀, t₁, t₂, p) = ((t₁ − t₀) × (t₂ − t₀))·(p − t₀)` by the filter of
-/// [`plane_signs`]: the same arithmetic in the same order.
+/// The sign of `O(t₀, t₁, t₂, p) = n·(p − t₀)` with `n = (t₁ − t₀) × (t₂ − t₀)`, in `f64`,
+/// where a filter proves it.
+///
+/// The filter: each of the six products `±e₁·e₂·w` of the determinant carries at most 9
+/// roundings (three differences, the cross product's products and difference, the dot
+/// product's products and sums), so the computed value errs by at most
+/// `γ(9)·perm < 2^-49.7·perm` with `perm` the sum of their absolute values; `perm` is itself
+/// computed with at most 6 roundings, so `2^-48·perm` bounds the error. A sign is certain when
+/// the value exceeds that bound. Near the ends of the range (`perm` below `2^-900`, where
+/// products could underflow, or not finite) nothing is certain and the exact predicate
+/// decides.
 #[inline(always)]
 fn orientation(t0: [f64; 3], t1: [f64; 3], t2: [f64; 3], p: [f64; 3]) -> Sign {
     let e1 = [t1[0] - t0[0], t1[1] - t0[1], t1[2] - t0[2]];
@@ -368,6 +345,16 @@ fn lone(s: [i8; 3]) -> usize {
 /// `O(p₁, r₁, r₂, p₂)` (both `<= 0`); zero is touching, which counts. (The opposite sign
 /// convention fails the exact reference of `tests/trees.rs` at once.)
 fn crossing(a: &[DVec3; 3], b: &[DVec3; 3], sa: [i8; 3], sb: [i8; 3]) -> bool {
+    let [[a0, a1, a2, a3], [b0, b1, b2, b3]] = crossing_corners(*a, *b, sa, sb);
+    orient(a0, a1, a2, a3) <= 0 && orient(b0, b1, b2, b3) <= 0
+}
+
+/// The arguments of [`crossing`]'s two orientations, `(p₁, q₁, p₂, q₂)` and
+/// `(p₁, r₁, r₂, p₂)`: each triangle rotated to put its lone corner first, and the other
+/// two swapped by the lone corner's side. The one home of that rule, for points of any
+/// type (the scalar test and the lane filter).
+#[inline(always)]
+fn crossing_corners<P: Copy>(a: [P; 3], b: [P; 3], sa: [i8; 3], sb: [i8; 3]) -> [[P; 4]; 2] {
     let (i, j) = (lone(sa), lone(sb));
     let (p1, mut q1, mut r1) = (a[i], a[(i + 1) % 3], a[(i + 2) % 3]);
     let (p2, mut q2, mut r2) = (b[j], b[(j + 1) % 3], b[(j + 2) % 3]);
@@ -377,7 +364,7 @@ fn crossing(a: &[DVec3; 3], b: &[DVec3; 3], sa: [i8; 3], sb: [i8; 3]) -> bool {
     if sb[j] < 0 {
         core::mem::swap(&mut q1, &mut r1);
     }
-    orient(p1, q1, p2, q2) <= 0 && orient(p1, r1, r2, p2) <= 0
+    [[p1, q1, p2, q2], [p1, r1, r2, p2]]
 }
 
 /// The squared distance from `p` to the segment `[a, b]` (`f64`, not exact).
