@@ -163,7 +163,7 @@ pub(crate) fn sign_branch_rigid2<L: Lane>(
 /// and the underflow of `S` many times over.
 ///
 /// Why nothing is subnormal on normal-range input (every nonzero value multiplied at least
-/// `2^-32`; see [`crate::method`]): such a value is a multiple of `2^-55`, so every exact
+/// `2^-32`; see [`crate::Method`]): such a value is a multiple of `2^-55`, so every exact
 /// product of two is a multiple of `2^-110`, and so is every exact sum of those. Rounding
 /// keeps a multiple of `2^-110` one (above `2^-87` the `f32` spacing is a multiple of
 /// `2^-110`; below, the value is representable), so every face is zero or at least

@@ -62,7 +62,7 @@
 //! | one pose for many boxes | `&pose` |
 //!
 //! A broadphase calls [`Batch::update`] instead: the same kernels, and only the fat boxes
-//! whose object left them are rewritten (see [`broadphase`]).
+//! whose object left them are rewritten.
 //!
 //! ## Features
 //!
@@ -82,7 +82,7 @@
 //!
 //! ## Transform classes
 //! Model only what the scene requires: every entry point takes any class of
-//! [`transform`], each with the cheapest kernel that is exact for it and its own bytes per
+//! [`Transform3`], each with the cheapest kernel that is exact for it and its own bytes per
 //! box: [`Translation3`] (spheres, particles: 12 bytes), [`Rigid3`] (quaternion +
 //! position: 28), [`Similarity3`] (plus a uniform scale: 32), [`Trs3`] (bevy's
 //! `Transform`: 40) and `glam::Affine3A` (48 useful bytes); in 2D [`Translation2`],
@@ -117,13 +117,13 @@
 //! - [`Rounding::Nearest`] results are plain `f32` arithmetic, each face within
 //!   `γ(n)·S + TINY_ERROR` of the exact face.
 //! - `S_i = |t_i| + sum_j |m_ij|·max(|min_j|, |max_j|)`; the constants per method are in
-//!   [`method`].
+//!   [`Method`].
 //! - Empty boxes map to `EMPTY`; NaN anywhere, or a non-finite matrix, to the invalid
 //!   `NAN` box; unbounded faces to the exact unbounded result (a zero entry contributes
 //!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
 //!
 //! ## Broadphase
-//! [`broadphase`]: [`Batch::update`] rewrites only the fat boxes whose object left them and
+//! [`Batch::update`] rewrites only the fat boxes whose object left them and
 //! returns the [`Moved`] set, over [`Active`] subsets, with [`Swept`] pose pairs and
 //! large-world poses (`f64` positions, boxes relative to an `f64` origin, proven to contain
 //! the exact image).
@@ -145,9 +145,9 @@ extern crate alloc;
 extern crate std;
 
 mod aabb;
-pub mod batch;
+mod batch;
 mod block;
-pub mod broadphase;
+mod broadphase;
 mod error;
 mod extended;
 mod fat;
@@ -155,21 +155,23 @@ mod fields;
 mod fit;
 mod kernel;
 mod lane;
-pub mod method;
+mod method;
 mod num;
 mod projective;
 mod simd;
 mod single;
-pub mod transform;
+mod transform;
 // Local-frame AABB trees (issue 11).
 pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
 pub use batch::*;
-pub use broadphase::{Active, LargeRigid3, Margin, Moved, Swept};
+pub use broadphase::{
+    Active, LargePose, LargeRigid3, LargeWorld, Margin, Moved, PoseSource, Swept,
+};
 pub use error::TransformError;
 pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};
-pub use method::{Method, Rounding};
+pub use method::{Method, Rounding, TINY_ERROR, TINY_PAD, UNIT_ROUNDOFF, gamma};
 pub use simd::Backend;
 pub use transform::{
     Rigid2, Rigid3, Similarity3, Transform2, Transform3, Translation2, Translation3, Trs3,

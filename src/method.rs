@@ -1,46 +1,4 @@
-//! The transform methods, the rounding modes and the error bound each pair guarantees.
-//!
-//! All bounds are stated against the exact image of the input box, computed in exact
-//! arithmetic from the given `f32` values, and scaled by the per-axis magnitude
-//!
-//! ```text
-//! S_i = |t_i| + sum_j |m_ij| * max(|min_j|, |max_j|)
-//! ```
-//!
-//! A bound relative to the result alone would be unsound: the faces of a rotated box
-//! can cancel to zero while the rounding errors that produced them did not.
-//!
-//! | method       | dims | Nearest error       | Outward pad            |
-//! |--------------|------|---------------------|------------------------|
-//! | `Naive`      | N    | `γ(N+1)·S + TINY_ERROR` | `(N+3)·u·S + TINY_PAD` |
-//! | `SignSelect` | N    | `γ(N+1)·S + TINY_ERROR` | `(N+3)·u·S + TINY_PAD` |
-//! | `AbsMatrix`  | N    | `γ(N+3)·S + TINY_ERROR` | `(N+5)·u·S + TINY_PAD` |
-//!
-//! `γ(n) = n·u / (1 − n·u)` with `u = 2^-24` (Higham's constant). Outward faces contain the
-//! exact faces and lie within twice the pad of them.
-//!
-//! ## Subnormal numbers, FTZ and DAZ
-//!
-//! Call an input **normal-range** when every nonzero finite value a kernel multiplies (box
-//! coordinates, translations, matrix entries; the computed entries of `R(q)` and the
-//! scaled box for the quaternion classes) is at least `2^-32` (about `2.3·10^-10`) in
-//! magnitude. Real scenes are: a rotation entry of exactly zero is fine, one of `10^-12`
-//! is not. On normal-range input no kernel reads or produces a subnormal number, on any
-//! path (the proof is beside the pads in `src/kernel.rs`), so none pays the microcode assist that Intel
-//! cores take for one, and the results are bit for bit the same whatever the MXCSR modes
-//! flush-to-zero (FTZ) and denormals-are-zero (DAZ) say: every guarantee holds with
-//! either or both set. The pads' absolute parts are normal constants for this reason.
-//!
-//! Outside that range (subnormal inputs, or products below `2^-126`) the default mode
-//! keeps every guarantee, at the CPU's subnormal speed: subnormal inputs take that slower
-//! path. Under FTZ the CPU flushes a result below `2^-126` to zero, an error under
-//! `2^-126` per operation; the pad's absolute part (at least `2^-102`; a translation's
-//! step from zero is `2^-104`) covers those errors for matrices whose entries are at most
-//! `2^16` in magnitude, so Outward still contains the exact image of inputs whose values
-//! are all normal (tested on boxes in the lowest normal binades).
-//! Under DAZ the CPU reads a subnormal input as zero: the result then bounds the box and
-//! map with those values replaced by zero, which can miss the exact image of the given
-//! values by about `2^-126·(1 + Σ_j |m_ij|)` per axis.
+//! `Method`, `Rounding` and the constants of the bounds (documented on [`Method`]).
 
 use crate::num::pow2;
 
@@ -76,6 +34,50 @@ pub fn gamma(n: u32) -> f64 {
 }
 
 /// How a box is carried through the transform.
+///
+/// # Methods, roundings and their bounds
+///
+/// All bounds are stated against the exact image of the input box, computed in exact
+/// arithmetic from the given `f32` values, and scaled by the per-axis magnitude
+///
+/// ```text
+/// S_i = |t_i| + sum_j |m_ij| * max(|min_j|, |max_j|)
+/// ```
+///
+/// A bound relative to the result alone would be unsound: the faces of a rotated box
+/// can cancel to zero while the rounding errors that produced them did not.
+///
+/// | method       | dims | Nearest error       | Outward pad            |
+/// |--------------|------|---------------------|------------------------|
+/// | `Naive`      | N    | `γ(N+1)·S + TINY_ERROR` | `(N+3)·u·S + TINY_PAD` |
+/// | `SignSelect` | N    | `γ(N+1)·S + TINY_ERROR` | `(N+3)·u·S + TINY_PAD` |
+/// | `AbsMatrix`  | N    | `γ(N+3)·S + TINY_ERROR` | `(N+5)·u·S + TINY_PAD` |
+///
+/// `γ(n) = n·u / (1 − n·u)` with `u = 2^-24` (Higham's constant). Outward faces contain the
+/// exact faces and lie within twice the pad of them.
+///
+/// ## Subnormal numbers, FTZ and DAZ
+///
+/// Call an input **normal-range** when every nonzero finite value a kernel multiplies (box
+/// coordinates, translations, matrix entries; the computed entries of `R(q)` and the
+/// scaled box for the quaternion classes) is at least `2^-32` (about `2.3·10^-10`) in
+/// magnitude. Real scenes are: a rotation entry of exactly zero is fine, one of `10^-12`
+/// is not. On normal-range input no kernel reads or produces a subnormal number, on any
+/// path (the proof is beside the pads in `src/kernel.rs`), so none pays the microcode assist that Intel
+/// cores take for one, and the results are bit for bit the same whatever the MXCSR modes
+/// flush-to-zero (FTZ) and denormals-are-zero (DAZ) say: every guarantee holds with
+/// either or both set. The pads' absolute parts are normal constants for this reason.
+///
+/// Outside that range (subnormal inputs, or products below `2^-126`) the default mode
+/// keeps every guarantee, at the CPU's subnormal speed: subnormal inputs take that slower
+/// path. Under FTZ the CPU flushes a result below `2^-126` to zero, an error under
+/// `2^-126` per operation; the pad's absolute part (at least `2^-102`; a translation's
+/// step from zero is `2^-104`) covers those errors for matrices whose entries are at most
+/// `2^16` in magnitude, so Outward still contains the exact image of inputs whose values
+/// are all normal (tested on boxes in the lowest normal binades).
+/// Under DAZ the CPU reads a subnormal input as zero: the result then bounds the box and
+/// map with those values replaced by zero, which can miss the exact image of the given
+/// values by about `2^-126·(1 + Σ_j |m_ij|)` per axis.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Method {

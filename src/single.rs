@@ -44,7 +44,7 @@ fn transform_scalar<const N: usize, T: Class<N>>(
 }
 
 impl Aabb3 {
-    /// The box through `xf`, any 3D [transform class](crate::transform), by `method`,
+    /// The box through `xf`, any 3D [transform class](crate::Transform3), by `method`,
     /// with the guarantee `rounding` gives.
     ///
     /// - [`Rounding::Outward`]: contains the exact image of every real point of `self`;
@@ -54,7 +54,7 @@ impl Aabb3 {
     ///   face, `n` being [`Transform3::nearest_order`]`(method)`.
     ///
     /// For an affine map `S_i = |t_i| + sum_j |m_ij|·max(|min_j|, |max_j|)` and `τ = 1`;
-    /// the other classes are in [`crate::transform`]. Empty in gives [`Aabb3::EMPTY`];
+    /// the other classes are listed on [`Transform3`]. Empty in gives [`Aabb3::EMPTY`];
     /// NaN anywhere, or a non-finite map, gives [`Aabb3::NAN`]. Runs on glam's SIMD
     /// `Vec3A` where it has one, else on [`Aabb3::transformed_scalar`].
     #[inline]
@@ -126,7 +126,7 @@ impl Aabb3 {
 }
 
 impl Aabb2 {
-    /// The box through `xf`, any 2D [transform class](crate::transform), by `method`,
+    /// The box through `xf`, any 2D [transform class](crate::Transform3), by `method`,
     /// with the guarantee `rounding` gives.
     ///
     /// The bounds of [`Aabb3::transformed`] with `dims = 2` and the order `n` of

@@ -6,11 +6,11 @@
 use bvkit_support::cases;
 use bvkit_support::oracle;
 
-use bvkit::broadphase::{LargePose, LargeWorld};
 use bvkit::{
     Aabb2, Aabb3, Active, Backend, Batch, BatchError, Block8, LargeRigid3, Margin, Method, Moved,
     Rigid2, Rigid3, Rounding, Soa, Swept,
 };
+use bvkit::{LargePose, LargeWorld};
 use glam::{Affine3A, DAffine3, DMat3, DVec3, Quat, Vec2, Vec3A};
 use rand::RngExt;
 use rand::rngs::StdRng;

@@ -7,11 +7,11 @@ use bvkit_support::cases;
 use bvkit_support::mxcsr;
 use bvkit_support::oracle;
 
-use bvkit::transform::{Transform2, Transform3};
 use bvkit::{
     Aabb2, Aabb3, Aabb3x8, Backend, Batch, BatchError, Block8, Method, Rigid2, Rigid3, Rounding,
     Similarity3, Soa, Translation2, Translation3, Trs3,
 };
+use bvkit::{Transform2, Transform3};
 use glam::{Affine2, Affine3A, Vec2, Vec3A};
 use proptest::prelude::*;
 use rand::RngExt;
@@ -643,7 +643,7 @@ fn ragged<S: Clone>(soa: &S, columns: fn(&mut S) -> &mut [Vec<f32>]) -> Vec<S> {
 
 #[test]
 fn ragged_soa_is_refused_with_nothing_written() {
-    use bvkit::broadphase::Swept;
+    use bvkit::Swept;
     use bvkit::{Active, BoundingVolume, Margin, Moved, Sphere};
     // 21 values: two whole lane blocks and a tail, so that a late index panic would come
     // after earlier blocks were written.

@@ -10,8 +10,8 @@ use bvkit_support::oracle;
 use bvkit_support::volumes;
 
 use bvkit::{
-    Aabb3, BatchError, BoundingVolume, Capsule, Obb3, Rigid3, Rounding, Similarity3, Translation3,
-    Trs3, transform::Transform3,
+    Aabb3, BatchError, BoundingVolume, Capsule, Obb3, Rigid3, Rounding, Similarity3, Transform3,
+    Translation3, Trs3,
 };
 use glam::{Affine3A, Mat3A, Quat, Vec3A};
 use rand::RngExt;

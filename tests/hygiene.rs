@@ -16,14 +16,14 @@
 use bvkit_support::mxcsr;
 use bvkit_support::trimesh;
 
-use bvkit::broadphase::LargeWorld;
-use bvkit::transform::{Transform2, Transform3};
+use bvkit::LargeWorld;
 use bvkit::tree::{AabbTree, Quantized, Query, TriMesh};
 use bvkit::{
     Aabb2, Aabb3, Active, Backend, Batch, Block8, BoundingVolume, Capsule, Fit, LargeRigid3,
     Margin, Method, Moved, Obb3, Rigid2, Rigid3, Rounding, Similarity3, Soa, Sphere, Swept,
     Translation2, Translation3, Trs3,
 };
+use bvkit::{Transform2, Transform3};
 use glam::{Affine2, Affine3A, DVec3, Mat2, Mat3, Mat4, Quat, Vec2, Vec3, Vec3A};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};

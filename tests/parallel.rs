@@ -35,7 +35,7 @@ fn bits(boxes: &[Aabb3]) -> Vec<[u32; 6]> {
 /// Every layout of one class, serial against parallel.
 fn same_bits<T>(local: &[Aabb3], xfs: &[T])
 where
-    T: bvkit::transform::Transform3 + Sync,
+    T: bvkit::Transform3 + Sync,
 {
     let n = local.len();
     let (lb, xb) = (Block8::pack(local), Block8::pack(xfs));

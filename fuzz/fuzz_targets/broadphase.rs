@@ -11,8 +11,8 @@
 //! is refused with nothing written.
 #![no_main]
 
-use bvkit::broadphase::{LargeWorld, Swept};
-use bvkit::transform::{Transform2, Transform3};
+use bvkit::{LargeWorld, Swept};
+use bvkit::{Transform2, Transform3};
 use bvkit::{
     Aabb2, Aabb3, Active, Backend, Batch, BatchError, Block8, LargeRigid3, Margin, Method, Moved,
     Rounding, Soa, Translation2, Translation3,

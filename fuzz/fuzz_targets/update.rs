@@ -5,7 +5,7 @@
 //! nothing written.
 #![no_main]
 
-use bvkit::broadphase::Swept;
+use bvkit::Swept;
 use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rounding};
 use bvkit_fuzz::Floats;
 use bvkit_fuzz::oracle::{Exact, Expected, Exactly, QuatProblem};

@@ -10,7 +10,7 @@
 use bvkit::{
     Aabb3, BatchError, Capsule, Obb3, Rounding, Similarity3, Sphere, Translation3,
 };
-use bvkit::transform::Transform3;
+use bvkit::Transform3;
 use bvkit_fuzz::Floats;
 use bvkit_fuzz::affine3;
 use bvkit_fuzz::volumes::world::{

@@ -1,21 +1,5 @@
-//! Batch transforms: many boxes at once, in any layout, through any transform class, on
-//! the best backend.
-//!
-//! One entry point, [`Batch::transform`], takes a [`BoxSource`], a [`TransformSource`] and
-//! a [`BoxSink`]:
-//!
-//! | layout | boxes read | boxes written | transforms read |
-//! |---|---|---|---|
-//! | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
-//! | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T>]` (`&[Rigid3x8]`, …) |
-//! | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
-//! | shared | | | `&T`: one transform for the whole batch |
-//!
-//! `T` is any transform class ([`crate::transform`]); 2D boxes (`Aabb2`) work the same
-//! way. Every combination runs the same lane-generic kernels as the single-box path and
-//! keeps the same contract; lengths are checked before anything is written, and any
-//! length is accepted (the last partial block runs one box at a time, in one lane of the
-//! same arithmetic).
+//! The batch engine: layouts, sources and sinks, and the lane and AoS loops (documented
+//! on [`Batch`]).
 
 mod aos;
 mod aos3;
@@ -110,7 +94,7 @@ impl fmt::Display for BatchError {
 
 impl core::error::Error for BatchError {}
 
-/// Boxes a batch reads, in some layout: see the [module docs](crate::batch) for the list.
+/// Boxes a batch reads, in some layout: see [`Batch`] for the list.
 pub trait BoxSource<const N: usize>: sealed::ReadBoxes<N> {}
 impl<const N: usize, S: sealed::ReadBoxes<N>> BoxSource<N> for S {}
 
@@ -325,6 +309,26 @@ impl<const N: usize, B: ReadBoxes<N>, X: ReadMaps<N>, O: WriteBoxes<N>> Job for 
 }
 
 /// How a batch runs: the method, the rounding and the backend.
+///
+/// # Batch transforms
+///
+/// Many boxes at once, in any layout, through any transform class, on the best backend.
+///
+/// One entry point, [`Batch::transform`], takes a [`BoxSource`], a [`TransformSource`] and
+/// a [`BoxSink`]:
+///
+/// | layout | boxes read | boxes written | transforms read |
+/// |---|---|---|---|
+/// | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
+/// | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T>]` (`&[Rigid3x8]`, …) |
+/// | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
+/// | shared | | | `&T`: one transform for the whole batch |
+///
+/// `T` is any transform class ([`crate::Transform3`], [`crate::Transform2`]); 2D boxes
+/// (`Aabb2`) work the same way. Every combination runs the same lane-generic kernels as the
+/// single-box path and keeps the same contract; lengths are checked before anything is
+/// written, and any length is accepted (the last partial block runs one box at a time, in
+/// one lane of the same arithmetic).
 ///
 /// ```
 /// use bvkit::{Aabb3, Batch, Method, Rigid3, Rounding};

@@ -38,7 +38,7 @@ impl LargeRigid3 {
 ///
 /// **Bound.** Per face, the result exceeds the exact face by at most twice the Outward pad
 /// of the rotation (`(n + 2)·u·S + τ·TINY_PAD` with `S` the local magnitude, see
-/// [`crate::transform`]), plus one `f32` ulp of `t − origin` and two of the face; for
+/// [`crate::Transform3`]), plus one `f32` ulp of `t − origin` and two of the face; for
 /// `DAffine3`, plus `2u·Σ_j |m_ij|·max(|lo_j|, |hi_j|)` for the rounding of the matrix to
 /// `f32`. At `10^12` from an origin near the object that is a few ulps of the local size,
 /// where an `f32` world position would be off by `2^16`.

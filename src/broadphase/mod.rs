@@ -1,43 +1,4 @@
-//! The per-frame broadphase update: fat boxes rewritten only when an object leaves them,
-//! and the set of objects whose fat box changed.
-//!
-//! A broadphase tree holds a *fat* box per object, larger than the object by a
-//! [`Margin`], so that small motions need no tree update. Each frame,
-//! [`Batch::update`] computes every active object's tight world box and compares it with
-//! its fat box:
-//! - inside: nothing is written;
-//! - outside (or NaN): the fat box is rewritten as the tight box grown by the margin and
-//!   rounded outward, and the object joins the [`Moved`] set, which the broadphase
-//!   reinserts.
-//!
-//! Every layout and transform class of [`crate::batch`] works, with the same method,
-//! rounding and backend, and so do [`Swept`] pose pairs (the union of the boxes at the
-//! current and the predicted pose, for continuous collision) and [`LargeWorld`] poses
-//! (`f64` positions, boxes relative to an `f64` origin, always rounded outward).
-//! [`Active`] restricts the update to a list or a mask of objects, so that sleeping and
-//! static objects cost nothing.
-//!
-//! ```
-//! use bvkit::broadphase::{Active, Margin, Moved};
-//! use bvkit::{Aabb3, Batch, Method, Rigid3, Rounding};
-//! use glam::{Quat, Vec3A};
-//!
-//! let local = vec![Aabb3::new(Vec3A::splat(-0.5), Vec3A::splat(0.5)); 100];
-//! let mut poses = vec![Rigid3::new(Quat::IDENTITY, Vec3A::ZERO); 100];
-//! let mut fat = vec![Aabb3::EMPTY; 100];
-//! let mut moved = Moved::new();
-//! let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
-//! let margin = Margin::new(0.1, 0.0);
-//!
-//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
-//! assert_eq!(moved.len(), 100); // every fat box was EMPTY
-//!
-//! poses[7].translation.x += 0.05; // within the margin: nothing moves
-//! poses[9].translation.x += 1.0; // out of its fat box
-//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
-//! assert_eq!(moved.indices(), &[9]);
-//! # Ok::<(), bvkit::BatchError>(())
-//! ```
+//! The per-frame broadphase update (documented on [`Batch::update`]).
 
 mod large;
 mod moved;
@@ -302,6 +263,48 @@ impl Batch {
     /// - [`BatchError::InvalidActive`]: an index is out of range or not strictly
     ///   ascending, or a mask has the wrong number of words or a bit past the last object;
     /// - [`BatchError::TooManyObjects`]: more objects than `u32` indices can name.
+    ///
+    /// # The broadphase update
+    ///
+    /// Fat boxes rewritten only when an object leaves them, and the set of objects whose fat
+    /// box changed.
+    ///
+    /// A broadphase tree holds a *fat* box per object, larger than the object by a
+    /// [`Margin`], so that small motions need no tree update. Each frame,
+    /// [`Batch::update`] computes every active object's tight world box and compares it with
+    /// its fat box:
+    /// - inside: nothing is written;
+    /// - outside (or NaN): the fat box is rewritten as the tight box grown by the margin and
+    ///   rounded outward, and the object joins the [`Moved`] set, which the broadphase
+    ///   reinserts.
+    ///
+    /// Every layout and transform class of [`Batch::transform`] works, with the same method,
+    /// rounding and backend, and so do [`Swept`] pose pairs (the union of the boxes at the
+    /// current and the predicted pose, for continuous collision) and [`LargeWorld`] poses
+    /// (`f64` positions, boxes relative to an `f64` origin, always rounded outward).
+    /// [`Active`] restricts the update to a list or a mask of objects, so that sleeping and
+    /// static objects cost nothing.
+    ///
+    /// ```
+    /// use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
+    /// use glam::{Quat, Vec3A};
+    ///
+    /// let local = vec![Aabb3::new(Vec3A::splat(-0.5), Vec3A::splat(0.5)); 100];
+    /// let mut poses = vec![Rigid3::new(Quat::IDENTITY, Vec3A::ZERO); 100];
+    /// let mut fat = vec![Aabb3::EMPTY; 100];
+    /// let mut moved = Moved::new();
+    /// let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+    /// let margin = Margin::new(0.1, 0.0);
+    ///
+    /// batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+    /// assert_eq!(moved.len(), 100); // every fat box was EMPTY
+    ///
+    /// poses[7].translation.x += 0.05; // within the margin: nothing moves
+    /// poses[9].translation.x += 1.0; // out of its fat box
+    /// batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+    /// assert_eq!(moved.indices(), &[9]);
+    /// # Ok::<(), bvkit::BatchError>(())
+    /// ```
     pub fn update<const N: usize>(
         &self,
         margin: Margin,

@@ -140,7 +140,7 @@ pub(crate) trait Shape {
 }
 
 /// A bounding volume ([`Obb3`], [`Sphere`], [`Capsule`]) whose world AABB under any 3D
-/// [transform class](crate::transform) bvkit computes: the axis-aligned bound of the image
+/// [transform class](crate::Transform3) bvkit computes: the axis-aligned bound of the image
 /// of the exact volume (the statement of its docs, exact on its `f32` fields) under the
 /// exact map.
 ///
@@ -152,11 +152,11 @@ pub(crate) trait Shape {
 /// Here `u = 2^-24`, `κ` is 1 for spheres and capsules and for a box the conditioning
 /// `κ = Σ_l |a_0l·B_0l| / |a_0·B_0|` of its axes, `B_0 = a_1 × a_2` (1 when orthonormal), and
 /// `S_i = |t_i| + Σ_k μ_ik·reach_k` with `μ_ik = |m_ik|` for an affine map (the identity
-/// for a translation) and `ρ·|s_k|` for a quaternion class, as in [`crate::transform`];
+/// for a translation) and `ρ·|s_k|` for a quaternion class, as in [`crate::Transform3`];
 /// `reach_k` is `|c_k| + Σ_j |b_jk|·h_j` for a box (`b_j` its dual basis, its axes when
 /// orthonormal), `|c_k| + r` for a sphere and `max(|a_k|, |b_k|) + r` for a capsule. As
 /// `|x_i| <= S_i`, for orthonormal axes these are within `3u·S_i + TINY_PAD` (Outward) and
-/// `γ(2)·S_i + TINY_ERROR` (Nearest), tighter than any box kernel of [`crate::method`].
+/// `γ(2)·S_i + TINY_ERROR` (Nearest), tighter than any box kernel of [`crate::Method`].
 ///
 /// Bad input follows the crate's contract: NaN anywhere, or a non-finite map parameter,
 /// gives [`Aabb3::NAN`]; an empty volume (a negative radius or half-extent) gives
@@ -192,7 +192,7 @@ pub trait BoundingVolume: Shape + Sized {
     }
 
     /// `out[k]` = the AABB of `volumes[k]` through transform `k`, or through the one shared
-    /// transform (`&T`); transforms in any layout of [`crate::batch`]. Each result is
+    /// transform (`&T`); transforms in any layout of [`crate::Batch`]. Each result is
     /// bitwise that of [`BoundingVolume::transformed_aabb`].
     ///
     /// # Errors

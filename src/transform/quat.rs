@@ -22,7 +22,7 @@ use crate::simd::Backend;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Rigid3 {
-    /// The rotation; used as stored (see the [module docs](crate::transform)).
+    /// The rotation; used as stored (see [`Transform3`](crate::Transform3)).
     pub rotation: Quat,
     /// The translation, applied after the rotation.
     pub translation: Vec3A,

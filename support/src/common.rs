@@ -272,7 +272,7 @@ pub fn configure(
 
 /// `out[k] = boxes[k].transformed(&xfs[k], method, rounding)` as a user writes it, with
 /// the method and rounding as constants at the call (each arm is its own loop).
-pub fn single_loop<T: bvkit::transform::Transform3>(
+pub fn single_loop<T: bvkit::Transform3>(
     boxes: &[Aabb3],
     xfs: &[T],
     out: &mut [Aabb3],

@@ -9,8 +9,8 @@
 //! `f64` only for reporting against a bound.
 #![allow(dead_code, clippy::needless_range_loop)]
 
-use bvkit::method::{TINY_ERROR, TINY_PAD};
 use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rigid3, Rounding, Similarity3, Trs3};
+use bvkit::{TINY_ERROR, TINY_PAD};
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Quat, Vec2, Vec3A};
 use num_bigint::BigInt;
 use num_traits::{Signed, ToPrimitive, Zero};
