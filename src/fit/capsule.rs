@@ -30,13 +30,13 @@ pub struct Capsule {
 
 /// A capsule in `f64`, before rounding.
 #[derive(Clone, Copy, Debug)]
-struct Shape {
+struct Capsule64 {
     a: DVec3,
     b: DVec3,
     radius: f64,
 }
 
-impl Shape {
+impl Capsule64 {
     /// `π r² |b − a| + 4/3 π r³`.
     fn volume(&self) -> f64 {
         PI * self.radius * self.radius * (self.a.distance(self.b) + 4.0 / 3.0 * self.radius)
@@ -60,12 +60,12 @@ impl Capsule {
     /// [`FitError::Overflow`] when the radius would overflow `f32`.
     pub fn fit(points: &[Vec3], fit: Fit) -> Result<Self, FitError> {
         let bounds = cloud::validate(points)?;
-        let shape = match fit {
-            Fit::Pca => pca_shape(points),
-            Fit::Fast => fast_shape(points),
-            Fit::Tight => tight_shape(points),
+        let capsule = match fit {
+            Fit::Pca => pca_capsule(points),
+            Fit::Fast => fast_capsule(points),
+            Fit::Tight => tight_capsule(points),
         };
-        Self::around(points, &bounds, shape.a, shape.b)
+        Self::around(points, &bounds, capsule.a, capsule.b)
     }
 
     /// The capsule on the segment `[a, b]`, its ends moved into the points' bounding box
@@ -101,7 +101,7 @@ impl Capsule {
     pub fn volume(&self) -> f32 {
         let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
         let radius = f64::from(self.radius);
-        Shape { a, b, radius }.volume() as f32
+        Capsule64 { a, b, radius }.volume() as f32
     }
 
     /// An axis-aligned box, rounded outward, that contains the capsule:
@@ -129,7 +129,7 @@ impl Capsule {
 /// reach up to `max(s − w)` and down to `min(s + w)`; when those cross, one point suffices
 /// (the capsule is a sphere). A point farther than `r` from the line counts with `w = 0`
 /// (the certified radius then grows to reach it).
-fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Shape {
+fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Capsule64 {
     let (mut top, mut bottom) = (f64::NEG_INFINITY, f64::INFINITY);
     for &p in points {
         let v = p - origin;
@@ -144,7 +144,7 @@ fn capped(points: &[DVec3], origin: DVec3, dir: DVec3, radius: f64) -> Shape {
     } else {
         (bottom, top)
     };
-    Shape {
+    Capsule64 {
         a: origin + dir * t0,
         b: origin + dir * t1,
         radius,
@@ -165,19 +165,19 @@ fn circle_axis(points: &[DVec3], dir: DVec3) -> (DVec3, f64) {
 }
 
 /// The capsule along `dir` centered by the minimum enclosing circle, with minimal caps.
-fn circle_shape(points: &[DVec3], dir: DVec3) -> Shape {
+fn circle_capsule(points: &[DVec3], dir: DVec3) -> Capsule64 {
     let (origin, radius) = circle_axis(points, dir);
     capped(points, origin, dir, radius)
 }
 
 /// The smallest of some capsules, skipping degenerate ones (a NaN axis from a degenerate
 /// frame: its volume is NaN, which must never win).
-fn smallest(shapes: impl IntoIterator<Item = Shape>) -> Shape {
-    shapes
+fn smallest(capsules: impl IntoIterator<Item = Capsule64>) -> Capsule64 {
+    capsules
         .into_iter()
         .filter(|s| s.volume().is_finite())
         .min_by(|a, b| a.volume().total_cmp(&b.volume()))
-        .unwrap_or(Shape {
+        .unwrap_or(Capsule64 {
             a: DVec3::ZERO,
             b: DVec3::ZERO,
             radius: 0.0,
@@ -186,7 +186,7 @@ fn smallest(shapes: impl IntoIterator<Item = Shape>) -> Shape {
 
 /// The PCA baseline: the major principal axis of the distinct points through their mean,
 /// the radius the largest distance from that line.
-fn pca_shape(points: &[Vec3]) -> Shape {
+fn pca_capsule(points: &[Vec3]) -> Capsule64 {
     let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
     let unique_f32: Vec<Vec3> = distinct.iter().map(|p| p.as_vec3()).collect();
     let moments = cloud::summary(&unique_f32);
@@ -201,7 +201,7 @@ fn pca_shape(points: &[Vec3]) -> Shape {
 /// The fast fit: the best of the fast box's three axes and the major principal axis (of
 /// the points as given), each centered by a minimum enclosing circle. The box's axes alone
 /// can all miss an elongated set's long direction when its box is turned about it.
-fn fast_shape(points: &[Vec3]) -> Shape {
+fn fast_capsule(points: &[Vec3]) -> Capsule64 {
     let exact_points: Vec<DVec3> = points.iter().map(|&p| exact(p)).collect();
     let frame =
         Obb3::fit(points, Fit::Fast).map_or(glam::DMat3::IDENTITY, |b| b.rotation.as_dmat3());
@@ -209,14 +209,14 @@ fn fast_shape(points: &[Vec3]) -> Shape {
     smallest(
         [frame.x_axis, frame.y_axis, frame.z_axis, major]
             .into_iter()
-            .filter_map(|axis| Some(circle_shape(&exact_points, axis.try_normalize()?))),
+            .filter_map(|axis| Some(circle_capsule(&exact_points, axis.try_normalize()?))),
     )
 }
 
 /// The best radius for the axis along `dir`: a golden-section search of the volume over
 /// `r` from the enclosing circle's radius (the thinnest capsule) to the radius at which
 /// the segment shrinks to a point (a sphere on the axis).
-fn best_radius(points: &[DVec3], dir: DVec3) -> Shape {
+fn best_radius(points: &[DVec3], dir: DVec3) -> Capsule64 {
     let (origin, thinnest) = circle_axis(points, dir);
     let sphere_like = capped(points, origin, dir, thinnest);
     let middle = 0.5 * (sphere_like.a + sphere_like.b);
@@ -241,7 +241,7 @@ fn best_radius(points: &[DVec3], dir: DVec3) -> Shape {
 /// The tight fit: from each axis of the tight box's candidate frames, a compass search
 /// over directions `normalize(d + θ0 e1 + θ1 e2)`, each direction with its best radius;
 /// never worse than the fast and PCA capsules.
-fn tight_shape(points: &[Vec3]) -> Shape {
+fn tight_capsule(points: &[Vec3]) -> Capsule64 {
     let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
     let mut tight = tight_frames(&distinct);
     cloud::shuffle(&mut tight.support);
@@ -255,6 +255,6 @@ fn tight_shape(points: &[Vec3]) -> Shape {
             best_radius(support, dir(t))
         })
     });
-    let baseline = [fast_shape(points), pca_shape(points)];
+    let baseline = [fast_capsule(points), pca_capsule(points)];
     smallest(searched.chain(baseline))
 }

@@ -134,7 +134,7 @@ fn stretch(xf: &Similarity3) -> f64 {
 }
 
 /// A volume whose image under a map can be bounded: the machinery behind [`BoundingVolume`].
-pub(crate) trait Shape {
+pub(crate) trait ImageBound {
     /// The bound of the image under `map` (`None`: a NaN or infinite map parameter).
     fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3;
 }
@@ -183,7 +183,7 @@ pub(crate) trait Shape {
 /// assert_eq!(world[3], balls[3].transformed_aabb(&pose, Rounding::Outward));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub trait BoundingVolume: Shape + Sized {
+pub trait BoundingVolume: ImageBound + Sized {
     /// The AABB of the volume's image under `xf` (see the [trait docs](BoundingVolume)).
     #[inline]
     #[must_use]
@@ -299,7 +299,7 @@ impl Obb3 {
 /// cross product, `M·B`, `·h`, the sum over `j`, `/D`, `±`), and `D` is within `γ(4)·κ`;
 /// the map's error adds `Σ_k ε_k·reach_k` with `reach = |c| + |B|·h/|D|`. The lemma's scale
 /// is therefore `2·(1 + κ)·magnitude(reach)` (module docs).
-impl Shape for Obb3 {
+impl ImageBound for Obb3 {
     fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
         let Some(map) = map.filter(|_| !self.is_nan()) else {
             return Aabb3::NAN;
@@ -359,13 +359,13 @@ fn swept_segment(map: Option<&Map>, [a, b]: [Vec3A; 2], radius: f32, rounding: R
     swept_point(map, a, radius, rounding).union(&swept_point(map, b, radius, rounding))
 }
 
-impl Shape for Sphere {
+impl ImageBound for Sphere {
     fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
         swept_segment(map, [self.center; 2], self.radius, rounding)
     }
 }
 
-impl Shape for Capsule {
+impl ImageBound for Capsule {
     fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
         swept_segment(map, [self.a, self.b], self.radius, rounding)
     }
