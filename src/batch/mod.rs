@@ -22,7 +22,7 @@ use crate::simd::Backend;
 /// |---|---|---|---|
 /// | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
 /// | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T>]` (`&[Rigid3x8]`, …) |
-/// | SoA columns | [`SoaRef`](crate::SoaRef), `&Soa` | [`SoaMut`](crate::SoaMut), `&mut Soa` | [`SoaRef`](crate::SoaRef), `&Soa` |
+/// | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
 /// | shared | | | `&T`: one transform for the whole batch |
 ///
 /// `T` is any transform class ([`crate::Transform3`], [`crate::Transform2`]); 2D boxes
