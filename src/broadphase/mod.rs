@@ -382,42 +382,26 @@ struct AosFat<'a> {
 }
 
 impl AosSink for AosFat<'_> {
-    #[inline(always)]
-    fn every(&mut self, len: usize, tight: impl Fn(usize) -> Aabb3) {
-        self.run(0, len, tight);
-    }
-    /// Scattered objects one at a time; a whole span as in [`AosFat::run`].
+    /// A whole span eight objects at a time: the tight boxes and the mask of those that
+    /// left their fat boxes, then a loop over its set bits (a branch per object would
+    /// mispredict on every object a walk moves at random; the loop mispredicts once per
+    /// eight). Scattered objects one at a time.
     #[inline(always)]
     fn span(&mut self, start: usize, count: usize, lanes: u64, tight: impl Fn(usize) -> Aabb3) {
-        if lanes.count_ones() as usize == count {
-            self.run(start, count, tight);
+        let fat = &mut self.fat[start..start + count];
+        if lanes.count_ones() as usize != count {
+            let mut bits = lanes;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                let tight = tight(k);
+                if !crate::fat::inside_aabb3(&tight, &fat[k]) {
+                    fat[k] = tight.fattened(self.margin);
+                    self.moved.record(start, 1 << k);
+                }
+                bits &= bits - 1;
+            }
             return;
         }
-        let fat = &mut self.fat[start..start + count];
-        let mut bits = lanes;
-        while bits != 0 {
-            let k = bits.trailing_zeros() as usize;
-            let tight = tight(k);
-            if !crate::fat::inside_aabb3(&tight, &fat[k]) {
-                fat[k] = tight.fattened(self.margin);
-                self.moved.record(start, 1 << k);
-            }
-            bits &= bits - 1;
-        }
-    }
-    fn prefetch(&self, i: usize) {
-        simd::prefetch(&self.fat[i]);
-    }
-}
-
-impl AosFat<'_> {
-    /// Objects `start..start + count` (`start` a multiple of 8) eight at a time: the tight
-    /// boxes and the mask of those that left their fat boxes, then a loop over its set
-    /// bits. A branch per object would mispredict on every object a walk moves at random;
-    /// the loop mispredicts once per eight.
-    #[inline(always)]
-    fn run(&mut self, start: usize, count: usize, tight: impl Fn(usize) -> Aabb3) {
-        let fat = &mut self.fat[start..start + count];
         for (c, fat) in fat.chunks_mut(8).enumerate() {
             let mut boxes = [Aabb3::EMPTY; 8];
             let mut left = 0;
@@ -433,5 +417,8 @@ impl AosFat<'_> {
             }
             self.moved.record(start + 8 * c, left);
         }
+    }
+    fn prefetch(&self, i: usize) {
+        simd::prefetch(&self.fat[i]);
     }
 }

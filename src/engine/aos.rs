@@ -19,8 +19,6 @@ const SPAN: usize = 64;
 
 /// Where the AoS loop's tight boxes go.
 pub(crate) trait AosSink {
-    /// Every one of the `len` objects: object `i`'s tight box is `tight(i)`.
-    fn every(&mut self, len: usize, tight: impl Fn(usize) -> Aabb3);
     /// The objects `start..start + count`, of which the `lanes` bits are active: object
     /// `start + k`'s tight box is `tight(k)`, computed where the sink asks for it.
     fn span(&mut self, start: usize, count: usize, lanes: u64, tight: impl Fn(usize) -> Aabb3);
@@ -31,19 +29,19 @@ pub(crate) trait AosSink {
 /// The plain AoS sink: every tight box written.
 impl AosSink for &mut [Aabb3] {
     #[inline(always)]
-    fn every(&mut self, len: usize, tight: impl Fn(usize) -> Aabb3) {
-        for (i, o) in self[..len].iter_mut().enumerate() {
-            *o = tight(i);
-        }
-    }
-    #[inline(always)]
     fn span(&mut self, start: usize, count: usize, lanes: u64, tight: impl Fn(usize) -> Aabb3) {
         let out = &mut self[start..start + count];
-        let mut bits = lanes;
-        while bits != 0 {
-            let k = bits.trailing_zeros() as usize;
-            out[k] = tight(k);
-            bits &= bits - 1;
+        if lanes.count_ones() as usize == count {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = tight(k);
+            }
+        } else {
+            let mut bits = lanes;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                out[k] = tight(k);
+                bits &= bits - 1;
+            }
         }
     }
     fn prefetch(&self, i: usize) {
@@ -110,53 +108,31 @@ impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
 }
 
 impl<T: Transform3, S: AosSink> AosOn<'_, T, S> {
-    /// Every active object through [`Aabb3::transformed`] (all of them in one loop, or a
-    /// span of [`SPAN`] objects at a time); `method` and `rounding` are constants at each
-    /// call site.
+    /// Every active object through [`Aabb3::transformed`], a span of [`SPAN`] objects at a
+    /// time; `method` and `rounding` are constants at each call site. Method calls rather
+    /// than a closure over the loop: a closure here was compiled out of line, with the
+    /// method and rounding as run-time values instead of constants.
     #[inline(always)]
     fn objects(self, method: Method, rounding: Rounding) {
-        // The poses split once, so that the loops see a slice or one pose.
-        match self.maps {
-            Maps::Each(poses) => {
-                let poses = &poses[..self.run.local.len()];
-                Self::walk(self.run, |i| &poses[i], method, rounding)
-            }
-            Maps::Shared(pose) => Self::walk(self.run, |_| pose, method, rounding),
-        }
-    }
-
-    #[inline(always)]
-    fn walk<'p>(
-        run: AosRun<'_, S>,
-        pose: impl Fn(usize) -> &'p T,
-        method: Method,
-        rounding: Rounding,
-    ) where
-        T: 'p,
-    {
+        let AosOn { run, maps } = self;
         let AosRun {
             local,
             mut sink,
             active,
             ..
         } = run;
-        let tight = |i: usize| local[i].transformed(pose(i), method, rounding);
-        if let Active::All = active {
-            // Every index is below `local.len()`, which the slices share: no bounds checks.
-            sink.every(local.len(), tight);
-            return;
-        }
         let ahead = |sink: &S, i: usize| {
             simd::prefetch(&local[i]);
-            simd::prefetch(pose(i));
+            simd::prefetch(maps.get(i));
             sink.prefetch(i);
         };
         let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
         for span in Spans::new(active, local.len(), SPAN) {
             lookahead.step(span, |i| ahead(&sink, i));
-            sink.span(span.start, span.count, span.lanes, |k| {
-                tight(span.start + k)
-            });
+            let (start, count) = (span.start, span.count);
+            let (local, maps) = (&local[start..start + count], maps.window(start, count));
+            let tight = |k: usize| local[k].transformed(maps.get(k), method, rounding);
+            sink.span(start, count, span.lanes, tight);
         }
     }
 }

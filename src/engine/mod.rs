@@ -216,24 +216,10 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Engine<'_
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'_, N, B, P, S> {
     /// The active objects in aligned spans of the lane width: a span with more than one
     /// active object runs in lanes (its inactive lanes are computed and ignored), a lone
-    /// active object and the tail run in one lane of the same arithmetic.
+    /// active object and the tail run in one lane of the same arithmetic (one call site
+    /// of each, so that the kernel is inlined twice per method).
     #[inline(always)]
     fn spans<L: LaneArray>(&mut self, method: Method, outward: bool) {
-        if let Active::All = self.active {
-            // Every object: a plain loop over whole spans, then the tail one lane at a
-            // time. Walking `Spans` here measured up to 1.5x slower on cheap kernels in
-            // cache (the per-span decoding and mask tests are not free there).
-            let (w, mut i) = (L::WIDTH, 0);
-            while i + w <= self.len {
-                self.lanes::<L>(i, w, u64::MAX >> (64 - w), method, outward);
-                i += w;
-            }
-            while i < self.len {
-                self.lanes::<L::One>(i, 1, 1, method, outward);
-                i += 1;
-            }
-            return;
-        }
         let mut ahead = Lookahead::new(self.active, self.len, |i| self.prefetch(i));
         for span in Spans::new(self.active, self.len, L::WIDTH) {
             ahead.step(span, |i| self.prefetch(i));

@@ -28,6 +28,26 @@ pub(crate) enum Maps<'a, T> {
     Shared(&'a T),
 }
 
+impl<'a, T> Maps<'a, T> {
+    /// The transforms of boxes `start..start + count`.
+    #[inline(always)]
+    pub(crate) fn window(self, start: usize, count: usize) -> Self {
+        match self {
+            Maps::Each(maps) => Maps::Each(&maps[start..start + count]),
+            Maps::Shared(map) => Maps::Shared(map),
+        }
+    }
+
+    /// The transform of box `i`.
+    #[inline(always)]
+    pub(crate) fn get(&self, i: usize) -> &T {
+        match self {
+            Maps::Each(maps) => &maps[i],
+            Maps::Shared(map) => map,
+        }
+    }
+}
+
 /// Boxes a batch reads, in some layout: see [`Batch`](crate::Batch) for the list.
 pub trait BoxSource<const N: usize>: sealed::ReadBoxes<N> {}
 impl<const N: usize, S: sealed::ReadBoxes<N>> BoxSource<N> for S {}
