@@ -9,10 +9,11 @@
 use glam::{Affine3A, Mat4, Vec2, Vec3A};
 
 use crate::aabb::{Aabb2, Aabb3};
+use crate::block;
 use crate::error::TransformError;
 use crate::extended;
 use crate::fields::MAX_FIELDS;
-use crate::kernel::{self, MapKernel};
+use crate::kernel::MapKernel;
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
 use crate::transform::{Class, Rigid2, Transform2, Transform3};
@@ -36,7 +37,7 @@ fn transform_scalar<const N: usize, T: Class<N>>(
     let fields: [f32; MAX_FIELDS] = xf.to_fields();
     let map = T::lanes::<f32>(&fields);
     let outward = rounding == Rounding::Outward;
-    match kernel::transform_checked(&map, Vector(lo), Vector(hi), method, outward) {
+    match block::transform(&map, Vector(lo), Vector(hi), method, outward) {
         (min, max, 0.0) => (min.0, max.0),
         _ => extended::transform(&xf.extended(), lo, hi, rounding),
     }

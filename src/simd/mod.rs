@@ -92,7 +92,7 @@ impl Backend {
         fastest()
     }
 
-    /// Boxes per lane vector: the width of the engine's spans.
+    /// Boxes per lane block.
     #[must_use]
     pub const fn lanes(self) -> usize {
         match self {
