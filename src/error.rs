@@ -44,3 +44,68 @@ impl fmt::Display for TransformError {
 }
 
 impl core::error::Error for TransformError {}
+
+/// Why a batch was refused. Nothing was written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BatchError {
+    /// Two inputs, or an input and the output, differ in length.
+    LengthMismatch {
+        /// Which sequence has the wrong length.
+        what: &'static str,
+        /// The length of the local boxes.
+        expected: usize,
+        /// The length found.
+        found: usize,
+    },
+    /// The backend asked for cannot run on this CPU.
+    UnsupportedBackend(crate::simd::Backend),
+    /// A broadphase margin is negative, infinite or NaN.
+    InvalidMargin(crate::fat::Margin),
+    /// A broadphase active set is malformed; the reason is given.
+    InvalidActive(&'static str),
+    /// More objects than `u32` indices can name.
+    TooManyObjects(usize),
+}
+
+impl BatchError {
+    /// `Ok` when `found == expected`, else [`BatchError::LengthMismatch`] for `what`: the one
+    /// place a length check is written.
+    #[inline]
+    pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), Self> {
+        if found == expected {
+            Ok(())
+        } else {
+            Err(Self::LengthMismatch {
+                what,
+                expected,
+                found,
+            })
+        }
+    }
+}
+
+impl fmt::Display for BatchError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::LengthMismatch {
+                what,
+                expected,
+                found,
+            } => write!(
+                f,
+                "{what} has length {found}, expected {expected} (the local boxes' length)"
+            ),
+            Self::UnsupportedBackend(b) => write!(f, "backend {b:?} is not supported by this CPU"),
+            Self::InvalidMargin(m) => write!(
+                f,
+                "margin {m:?} is invalid: both fields must be finite and non-negative"
+            ),
+            Self::InvalidActive(why) => write!(f, "invalid active set: {why}"),
+            Self::TooManyObjects(n) => {
+                write!(f, "{n} objects is more than u32 indices can name")
+            }
+        }
+    }
+}
+
+impl core::error::Error for BatchError {}

@@ -20,7 +20,8 @@ pub fn vector_at<L: Copy, const N: usize>(f: &[L; MAX_FIELDS], k: usize) -> Vect
 pub trait Fields: Copy + Send + Sync {
     /// The number of `f32` fields.
     const FIELDS: usize;
-    /// `[C; FIELDS]`: one `C` per field (a lane block, a column, …).
+    /// `[C; FIELDS]`: one `C` per field (a field's eight values in an AoSoA block, a
+    /// column, …).
     type Array<C: Send + Sync>: AsRef<[C]> + AsMut<[C]> + Send + Sync;
     /// The array whose entry `n` is `f(n)`.
     fn array<C: Send + Sync>(f: impl FnMut(usize) -> C) -> Self::Array<C>;

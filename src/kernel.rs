@@ -6,7 +6,9 @@
 //! Everything outside that domain (empty, unbounded or NaN boxes, overflow, non-finite
 //! matrices) is answered by [`crate::extended`].
 
-use crate::lane::{Axes, Lane};
+use core::ops::{Add, Mul, Sub};
+
+use crate::lane::{Axes, Lane, Vector};
 use crate::method::{Method, REACH_FLOOR, UNIT_ROUNDOFF};
 
 /// A box through a map in lanes: the kernel of one transform class.
@@ -271,20 +273,24 @@ fn step_down<V: Lane>(x: V) -> V {
 /// writes it, with no normalisation: columns `(1 − (yy + zz), xy + wz, xz − wy)`,
 /// `(xy − wz, 1 − (xx + zz), yz + wx)`, `(xz + wy, yz − wx, 1 − (xx + yy))` with
 /// `xy = x·2y` and so on; and `ρ = 1 + 2‖q‖²`, which bounds every `|R_ij|` (for the
-/// diagonal `|1 − 2(y² + z²)| <= 1 + 2‖q‖²`; off it `2|xy| + 2|wz| <= ‖q‖²`).
+/// diagonal `|1 − 2(y² + z²)| <= 1 + 2‖q‖²`; off it `2|xy| + 2|wz| <= ‖q‖²`). The one
+/// formula of `R(q)`: in `f32` lanes for the kernels, in `f64` for the trees' relative
+/// pose (`one` is the number 1 in `T`).
 ///
-/// Error: the doublings are exact, each product rounds once, and each entry is a sum of two
-/// products (then one more rounding with the `1`): every computed entry is within
-/// `γ(3)·ρ` of the exact one. An underflowing product errs by at most `2^-150` absolutely,
-/// which is below `2^-126·u·ρ` since `ρ >= 1`. Plain multiplications and additions, never
-/// fused: every backend forms the same `R`.
+/// Error, in `f32`: the doublings are exact, each product rounds once, and each entry is a
+/// sum of two products (then one more rounding with the `1`): every computed entry is
+/// within `γ(3)·ρ` of the exact one. An underflowing product errs by at most `2^-150`
+/// absolutely, which is below `2^-126·u·ρ` since `ρ >= 1`. Plain multiplications and
+/// additions, never fused: every backend forms the same `R`.
 #[inline(always)]
-pub(crate) fn rotation<L: Lane>([x, y, z, w]: [L; 4]) -> ([[L; 3]; 3], L) {
+pub(crate) fn rotation<T>([x, y, z, w]: [T; 4], one: T) -> ([[T; 3]; 3], T)
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
     let (x2, y2, z2) = (x + x, y + y, z + z);
     let (xx, yy, zz) = (x * x2, y * y2, z * z2);
     let (xy, xz, yz) = (x * y2, x * z2, y * z2);
     let (wx, wy, wz) = (w * x2, w * y2, w * z2);
-    let one = L::splat(1.0);
     let cols = [
         [one - (yy + zz), xy + wz, xz - wy],
         [xy - wz, one - (xx + zz), yz + wx],
@@ -320,4 +326,33 @@ pub(crate) fn rotation_pad<V: Axes>(rho: V, t: V, lo: V, hi: V, k: u32) -> V {
     let magnitude = hi.max(-lo);
     let sum = magnitude.axis(0) + magnitude.axis(1) + magnitude.axis(2) + V::splat(REACH_FLOOR);
     rho.mul_add(sum, t.abs()) * V::splat(k as f32 * UNIT_ROUNDOFF)
+}
+
+/// The boxes `[lo, hi]` through `map` on the fast path, with a lane value that says where
+/// the result stands: 0 where the box is non-empty with no NaN and the result finite,
+/// NaN elsewhere. Those lanes must be recomputed by
+/// [`crate::extended`]. One float per lane lets a single compare test every lane.
+///
+/// Per axis: `(hi − lo).select_nonneg(0, NaN)` is 0 for a non-empty axis (an overflowing
+/// `hi − lo = +inf` included) and NaN for an empty or NaN one, and `(max − min)·0` is 0
+/// for finite faces and NaN for an infinite or NaN one (every kernel gives `min <= max`
+/// for a non-empty box; a finite box wider than `f32::MAX` also gives NaN and takes the
+/// extended path, as on the single-box path, so that both agree bit for bit).
+#[inline(always)]
+pub(crate) fn transform_checked<L: Lane, const N: usize, M: MapKernel<Vector<L, N>>>(
+    map: &M,
+    lo: Vector<L, N>,
+    hi: Vector<L, N>,
+    method: Method,
+    outward: bool,
+) -> (Vector<L, N>, Vector<L, N>, L) {
+    let (min, max) = map.transform(lo, hi, method, outward);
+    let (zero, nan) = (L::splat(0.0), L::splat(f32::NAN));
+    let mut stands = zero;
+    for i in 0..N {
+        let empty = (hi.0[i] - lo.0[i]).select_nonneg(zero, nan);
+        let unbounded = (max.0[i] - min.0[i]) * zero;
+        stands = stands + empty + unbounded;
+    }
+    (min, max, stands)
 }

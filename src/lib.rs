@@ -146,8 +146,8 @@ extern crate std;
 
 mod aabb;
 mod batch;
-mod block;
 mod broadphase;
+mod engine;
 mod error;
 mod extended;
 mod fat;
@@ -155,6 +155,7 @@ mod fields;
 mod fit;
 mod kernel;
 mod lane;
+mod layout;
 mod method;
 mod num;
 mod projective;
@@ -165,12 +166,18 @@ mod transform;
 pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
-pub use batch::*;
-pub use broadphase::{
-    Active, LargePose, LargeRigid3, LargeWorld, Margin, Moved, PoseSource, Swept,
-};
-pub use error::TransformError;
+pub use batch::Batch;
+pub use broadphase::{LargePose, LargeRigid3, LargeWorld, Moved, PoseSource, Swept};
+pub use engine::Active;
+pub use error::{BatchError, TransformError};
+pub use fat::Margin;
 pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};
+pub use layout::{
+    Aabb2Soa, Aabb2SoaMut, Aabb2SoaRef, Aabb2x8, Aabb3x8, AabbSoa, AabbSoaMut, AabbSoaRef,
+    Affine2x8, Affine3Soa, Affine3SoaRef, Affine3x8, Block8, BoxSink, BoxSource, Rigid2x8,
+    Rigid3Soa, Rigid3SoaRef, Rigid3x8, Similarity3x8, Soa, SoaMut, SoaRef, TransformSource,
+    Translation2x8, Translation3x8, Trs3x8,
+};
 pub use method::{Method, Rounding, TINY_ERROR, TINY_PAD, UNIT_ROUNDOFF, gamma};
 pub use simd::Backend;
 pub use transform::{

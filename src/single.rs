@@ -9,11 +9,10 @@
 use glam::{Affine3A, Mat4, Vec2, Vec3A};
 
 use crate::aabb::{Aabb2, Aabb3};
-use crate::block;
 use crate::error::TransformError;
 use crate::extended;
 use crate::fields::MAX_FIELDS;
-use crate::kernel::MapKernel;
+use crate::kernel::{self, MapKernel};
 use crate::lane::Vector;
 use crate::method::{Method, Rounding};
 use crate::transform::{Class, Rigid2, Transform2, Transform3};
@@ -37,7 +36,7 @@ fn transform_scalar<const N: usize, T: Class<N>>(
     let fields: [f32; MAX_FIELDS] = xf.to_fields();
     let map = T::lanes::<f32>(&fields);
     let outward = rounding == Rounding::Outward;
-    match block::transform(&map, Vector(lo), Vector(hi), method, outward) {
+    match kernel::transform_checked(&map, Vector(lo), Vector(hi), method, outward) {
         (min, max, 0.0) => (min.0, max.0),
         _ => extended::transform(&xf.extended(), lo, hi, rounding),
     }
@@ -57,7 +56,7 @@ impl Aabb3 {
     /// the other classes are listed on [`Transform3`]. Empty in gives [`Aabb3::EMPTY`];
     /// NaN anywhere, or a non-finite map, gives [`Aabb3::NAN`]. Runs on glam's SIMD
     /// `Vec3A` where it has one, else on [`Aabb3::transformed_scalar`].
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn transformed<T: Transform3>(&self, xf: &T, method: Method, rounding: Rounding) -> Aabb3 {
         if !GLAM_SIMD {

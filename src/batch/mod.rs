@@ -1,312 +1,13 @@
-//! The batch engine: layouts, sources and sinks, and the lane and AoS loops (documented
-//! on [`Batch`]).
+//! Batch transforms: [`Batch`], a thin public layer over the engine.
 
-mod aos;
-mod aos3;
-mod aosoa;
 #[cfg(feature = "rayon")]
 mod parallel;
-mod soa;
 
-use core::fmt;
-
-use crate::block;
-use crate::extended;
-use crate::lane::Vector;
+use crate::engine::{Active, AosRun, Engine, Poses, Store};
+use crate::error::BatchError;
+use crate::layout::{BoxSink, BoxSource, ReadBoxes, ReadMaps, TransformSource, WriteBoxes};
 use crate::method::{Method, Rounding};
-use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::Class;
-
-pub use aosoa::{
-    Aabb2x8, Aabb3x8, Affine2x8, Affine3x8, Block8, Rigid2x8, Rigid3x8, Similarity3x8,
-    Translation2x8, Translation3x8, Trs3x8,
-};
-pub use soa::{
-    Aabb2Soa, Aabb2SoaMut, Aabb2SoaRef, AabbSoa, AabbSoaMut, AabbSoaRef, Affine3Soa, Affine3SoaRef,
-    Rigid3Soa, Rigid3SoaRef, Soa, SoaMut, SoaRef,
-};
-
-use crate::aabb::Aabb3;
-pub(crate) use aos3::{Aos3, Maps};
-
-/// Why a batch was refused. Nothing was written.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BatchError {
-    /// Two inputs, or an input and the output, differ in length.
-    LengthMismatch {
-        /// Which sequence has the wrong length.
-        what: &'static str,
-        /// The length of the local boxes.
-        expected: usize,
-        /// The length found.
-        found: usize,
-    },
-    /// The backend asked for cannot run on this CPU.
-    UnsupportedBackend(Backend),
-    /// A broadphase margin is negative, infinite or NaN.
-    InvalidMargin(crate::fat::Margin),
-    /// A broadphase active set is malformed; the reason is given.
-    InvalidActive(&'static str),
-    /// More objects than `u32` indices can name.
-    TooManyObjects(usize),
-}
-
-impl BatchError {
-    /// `Ok` when `found == expected`, else [`BatchError::LengthMismatch`] for `what`: the one
-    /// place a length check is written.
-    #[inline]
-    pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), Self> {
-        if found == expected {
-            Ok(())
-        } else {
-            Err(Self::LengthMismatch {
-                what,
-                expected,
-                found,
-            })
-        }
-    }
-}
-
-impl fmt::Display for BatchError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::LengthMismatch {
-                what,
-                expected,
-                found,
-            } => write!(
-                f,
-                "{what} has length {found}, expected {expected} (the local boxes' length)"
-            ),
-            Self::UnsupportedBackend(b) => write!(f, "backend {b:?} is not supported by this CPU"),
-            Self::InvalidMargin(m) => write!(
-                f,
-                "margin {m:?} is invalid: both fields must be finite and non-negative"
-            ),
-            Self::InvalidActive(why) => write!(f, "invalid active set: {why}"),
-            Self::TooManyObjects(n) => {
-                write!(f, "{n} objects is more than u32 indices can name")
-            }
-        }
-    }
-}
-
-impl core::error::Error for BatchError {}
-
-/// Boxes a batch reads, in some layout: see [`Batch`] for the list.
-pub trait BoxSource<const N: usize>: sealed::ReadBoxes<N> {}
-impl<const N: usize, S: sealed::ReadBoxes<N>> BoxSource<N> for S {}
-
-/// Boxes a batch writes, in some layout.
-pub trait BoxSink<const N: usize>: sealed::WriteBoxes<N> {}
-impl<const N: usize, S: sealed::WriteBoxes<N>> BoxSink<N> for S {}
-
-/// Transforms a batch reads: one per box in some layout, or one shared by all.
-pub trait TransformSource<const N: usize>: sealed::ReadMaps<N> {}
-impl<const N: usize, S: sealed::ReadMaps<N>> TransformSource<N> for S {}
-
-pub(crate) mod sealed {
-    //! What a layout must do: load lanes, store lanes, and hand single items to the
-    //! extended path.
-
-    use super::*;
-
-    /// Boxes to read.
-    pub trait ReadBoxes<const N: usize> {
-        /// The number of boxes, or an error when the layout's columns disagree.
-        fn len(&self) -> Result<usize, BatchError>;
-        /// Boxes `i..i + count` (`count <= L::WIDTH`) as lanes; lanes past `count` are zero.
-        fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
-        /// Box `i` as `(min, max)`, for the extended path.
-        fn get(&self, i: usize) -> ([f32; N], [f32; N]);
-        /// The boxes as an AoS slice of [`Aabb3`], when they are one.
-        fn aabb3s(&self) -> Option<&[Aabb3]> {
-            None
-        }
-        /// Asks for box `i`'s cache lines ahead of a scattered access.
-        fn prefetch(&self, i: usize) {
-            let _ = i;
-        }
-    }
-
-    /// Boxes to write.
-    pub trait WriteBoxes<const N: usize> {
-        /// The number of boxes, or an error when the layout's columns disagree (`&mut`, so
-        /// that a `Vec` can ask its slice).
-        fn len(&mut self) -> Result<usize, BatchError>;
-        /// Writes lanes `0..count` to boxes `i..i + count`.
-        fn store<L: LaneArray>(
-            &mut self,
-            i: usize,
-            count: usize,
-            min: Vector<L, N>,
-            max: Vector<L, N>,
-        );
-        /// [`WriteBoxes::store`] past the caches where the layout allows it (whole AoSoA
-        /// blocks); the caller fences before returning.
-        #[inline(always)]
-        fn store_streaming<L: LaneArray>(
-            &mut self,
-            i: usize,
-            count: usize,
-            min: Vector<L, N>,
-            max: Vector<L, N>,
-        ) {
-            self.store(i, count, min, max);
-        }
-        /// Writes box `i`.
-        fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
-        /// The boxes as an AoS slice of [`Aabb3`], when they are one.
-        fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
-            None
-        }
-        /// The same boxes as a source, for the broadphase update, which reads the fat
-        /// boxes it may rewrite.
-        type Read<'r>: ReadBoxes<N>
-        where
-            Self: 'r;
-        /// The boxes as a source.
-        fn read(&self) -> Self::Read<'_>;
-        /// A part of the sink: the same layout over a run of boxes.
-        #[cfg(feature = "rayon")]
-        type Part<'p>: WriteBoxes<N> + Send
-        where
-            Self: 'p;
-        /// Disjoint parts of `chunk` boxes each, in order (the last may be shorter);
-        /// `chunk` is a multiple of 16, so that parts start on whole AoSoA and lane blocks.
-        #[cfg(feature = "rayon")]
-        fn parts(&mut self, chunk: usize) -> alloc::vec::Vec<Self::Part<'_>>;
-    }
-
-    /// Transforms to read.
-    pub trait ReadMaps<const N: usize> {
-        /// The transform class.
-        type Class: Class<N>;
-        /// The number of transforms, `None` for one shared transform, or an error when
-        /// the layout's columns disagree.
-        fn len(&self) -> Result<Option<usize>, BatchError>;
-        /// Transforms `i..i + count` as lanes; lanes past `count` are zero.
-        fn load<L: LaneArray>(&self, i: usize, count: usize)
-        -> <Self::Class as Class<N>>::Lanes<L>;
-        /// Transform `i`, for the extended path.
-        fn get(&self, i: usize) -> Self::Class;
-        /// The transforms as an AoS slice or one shared transform, when they are.
-        fn maps(&self) -> Option<Maps<'_, Self::Class>> {
-            None
-        }
-        /// Asks for transform `i`'s cache lines ahead of a scattered access.
-        fn prefetch(&self, i: usize) {
-            let _ = i;
-        }
-    }
-}
-
-use sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-
-/// Box `(min, max)` lanes from the fields of a box type in lanes.
-#[inline(always)]
-fn box_lanes<L: Copy, const N: usize>(
-    f: &[L; crate::fields::MAX_FIELDS],
-) -> (Vector<L, N>, Vector<L, N>) {
-    (
-        crate::fields::vector_at(f, 0),
-        crate::fields::vector_at(f, N),
-    )
-}
-
-/// The job every batch runs: blocks of lanes through the kernel.
-struct Run<B, X, O> {
-    local: B,
-    xf: X,
-    out: O,
-    len: usize,
-    method: Method,
-    rounding: Rounding,
-    /// Store past the caches: the output is larger than [`Batch::NON_TEMPORAL_BYTES`].
-    stream: bool,
-}
-
-impl<B, X, O> Run<B, X, O> {
-    /// Every block with one kernel; `method` is a constant at each call site, so that each
-    /// loop is specialised to its kernel.
-    #[inline(always)]
-    fn blocks<L: LaneArray, const N: usize>(&mut self, method: Method, outward: bool)
-    where
-        B: ReadBoxes<N>,
-        X: ReadMaps<N>,
-        O: WriteBoxes<N>,
-    {
-        let w = L::WIDTH;
-        let mut i = 0;
-        while i + w <= self.len {
-            self.block::<L, N>(i, w, method, outward);
-            i += w;
-        }
-        // The tail one box at a time, in one lane of the same arithmetic: smaller code than
-        // a masked block, and the same bits.
-        while i < self.len {
-            self.block::<L::One, N>(i, 1, method, outward);
-            i += 1;
-        }
-    }
-
-    #[inline(always)]
-    fn block<L: LaneArray, const N: usize>(
-        &mut self,
-        i: usize,
-        count: usize,
-        method: Method,
-        outward: bool,
-    ) where
-        B: ReadBoxes<N>,
-        X: ReadMaps<N>,
-        O: WriteBoxes<N>,
-    {
-        let (lo, hi) = self.local.load::<L>(i, count);
-        let map = self.xf.load::<L>(i, count);
-        let (min, max, stands) = block::transform(&map, lo, hi, method, outward);
-        if self.stream {
-            self.out.store_streaming(i, count, min, max);
-        } else {
-            self.out.store(i, count, min, max);
-        }
-        // The rare lanes that do not stand are recomputed from the source data; nothing
-        // here takes `&mut self` out of line, so the layout descriptors stay in registers.
-        if stands.any_nonzero() {
-            for k in 0..count {
-                if stands.get(k) != 0.0 {
-                    let (lo, hi) = self.local.get(i + k);
-                    let map = self.xf.get(i + k).extended();
-                    let (min, max) = extended::transform(&map, lo, hi, self.rounding);
-                    self.out.set(i + k, min, max);
-                }
-            }
-        }
-    }
-}
-
-/// A [`Run`] in `N` dimensions, as a [`Job`] for the dispatcher.
-struct RunN<const N: usize, B, X, O>(Run<B, X, O>);
-
-impl<const N: usize, B: ReadBoxes<N>, X: ReadMaps<N>, O: WriteBoxes<N>> Job for RunN<N, B, X, O> {
-    /// One loop per method, so that each is specialised to its kernel; the rounding is a
-    /// loop-invariant branch (specialising it too doubled the code, and the build time of
-    /// every call site, for no measurable speed).
-    #[inline(always)]
-    fn run<L: LaneArray>(self) {
-        let mut run = self.0;
-        let outward = run.rounding == Rounding::Outward;
-        match run.method {
-            Method::Naive => run.blocks::<L, N>(Method::Naive, outward),
-            Method::AbsMatrix => run.blocks::<L, N>(Method::AbsMatrix, outward),
-            Method::SignSelect => run.blocks::<L, N>(Method::SignSelect, outward),
-        }
-        if run.stream {
-            simd::store_fence();
-        }
-    }
-}
+use crate::simd::Backend;
 
 /// How a batch runs: the method, the rounding and the backend.
 ///
@@ -321,13 +22,13 @@ impl<const N: usize, B: ReadBoxes<N>, X: ReadMaps<N>, O: WriteBoxes<N>> Job for 
 /// |---|---|---|---|
 /// | AoS slices | `&[Aabb3]`, `&Vec<Aabb3>` | `&mut [Aabb3]`, `&mut Vec<Aabb3>` | `&[T]`, `&Vec<T>` |
 /// | AoSoA blocks of 8 | `&[Aabb3x8]` | `&mut [Aabb3x8]` | `&[Block8<T>]` (`&[Rigid3x8]`, …) |
-/// | SoA columns | [`SoaRef`], `&Soa` | [`SoaMut`], `&mut Soa` | [`SoaRef`], `&Soa` |
+/// | SoA columns | [`SoaRef`](crate::SoaRef), `&Soa` | [`SoaMut`](crate::SoaMut), `&mut Soa` | [`SoaRef`](crate::SoaRef), `&Soa` |
 /// | shared | | | `&T`: one transform for the whole batch |
 ///
 /// `T` is any transform class ([`crate::Transform3`], [`crate::Transform2`]); 2D boxes
 /// (`Aabb2`) work the same way. Every combination runs the same lane-generic kernels as the
 /// single-box path and keeps the same contract; lengths are checked before anything is
-/// written, and any length is accepted (the last partial block runs one box at a time, in
+/// written, and any length is accepted (the last partial span runs one box at a time, in
 /// one lane of the same arithmetic).
 ///
 /// ```
@@ -423,33 +124,33 @@ impl Batch {
         mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
         let len = checked_len(&local, &xf, &mut out)?;
-        if let (false, Some(local), Some(maps), Some(out)) = (
-            self.deterministic,
-            local.aabb3s(),
-            xf.maps(),
-            out.aabb3s_mut(),
-        ) {
-            let batch = Aos3 {
-                local,
-                maps,
-                out,
+        if let (false, Some(boxes), Some(sink)) =
+            (self.deterministic, local.aabb3s(), out.aabb3s_mut())
+        {
+            let run = AosRun {
+                local: boxes,
+                sink,
+                active: Active::All,
                 method: self.method,
                 rounding: self.rounding,
             };
-            if Class::run_simd3(batch, self.backend) {
+            if xf.run_aos(run, self.backend) {
                 return Ok(());
             }
         }
-        let run = Run {
+        let engine = Engine {
             local,
-            xf,
-            out,
+            poses: xf,
+            sink: Store {
+                out,
+                stream: len.saturating_mul(2 * N * size_of::<f32>()) > Self::NON_TEMPORAL_BYTES,
+            },
             len,
+            active: Active::All,
             method: self.method,
             rounding: self.rounding,
-            stream: len.saturating_mul(2 * N * size_of::<f32>()) > Self::NON_TEMPORAL_BYTES,
         };
-        simd::dispatch(self.backend, !self.deterministic, RunN::<N, _, _, _>(run));
+        engine.run(self.backend, !self.deterministic);
         Ok(())
     }
 }
@@ -468,12 +169,6 @@ fn checked_len<const N: usize>(
     Ok(len)
 }
 
-/// Lane helpers shared by the layouts.
-#[inline(always)]
-fn zero_fields<L: LaneArray>() -> [L; crate::fields::MAX_FIELDS] {
-    [L::splat(0.0); crate::fields::MAX_FIELDS]
-}
-
 #[cfg(test)]
 mod tests {
     //! The 16-lane instantiation (the AVX-512 backend's lane type) run without AVX-512:
@@ -483,7 +178,9 @@ mod tests {
     //! on CPUs that cannot run the AVX-512 backend.
 
     use super::*;
-    use crate::simd::F32s;
+    use crate::aabb::Aabb3;
+    use crate::layout::{Aabb3x8, Block8};
+    use crate::simd::{F32s, LaneArray};
     use crate::transform::{Rigid3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
@@ -496,16 +193,16 @@ mod tests {
         mut out: O,
     ) {
         let len = checked_len(&local, &xf, &mut out).expect("lengths");
-        let run = Run {
+        let engine = Engine {
             local,
-            xf,
-            out,
+            poses: xf,
+            sink: Store { out, stream: false },
             len,
+            active: Active::All,
             method,
             rounding,
-            stream: false,
         };
-        RunN::<3, _, _, _>(run).run::<L>();
+        engine.run_in::<L>();
     }
 
     fn inputs(n: usize) -> (Vec<Aabb3>, Vec<Affine3A>, Vec<Trs3>) {

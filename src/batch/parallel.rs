@@ -1,16 +1,17 @@
 //! Parallel batches on the rayon pool (feature `rayon`).
 //!
-//! The output is split into parts of whole lane blocks; each part runs the serial batch on
+//! The output is split into parts of whole spans (and whole AoSoA blocks); each part runs the serial batch on
 //! a window of the inputs. Every box is computed by the same code whichever part it falls
 //! in (the tail runs in one lane of the same arithmetic), so the result is bit-identical
 //! to [`Batch::transform`] on the same backend.
 
 use rayon::prelude::*;
 
-use super::sealed::{ReadBoxes, ReadMaps};
-use super::{Batch, BatchError, BoxSink, BoxSource, Maps, TransformSource, checked_len};
+use super::{Batch, checked_len};
 use crate::aabb::Aabb3;
+use crate::error::BatchError;
 use crate::lane::Vector;
+use crate::layout::{BoxSink, BoxSource, Maps, ReadBoxes, ReadMaps, TransformSource};
 use crate::simd::LaneArray;
 use crate::transform::Class;
 

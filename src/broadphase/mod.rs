@@ -1,36 +1,24 @@
-//! The per-frame broadphase update (documented on [`Batch::update`]).
+//! The per-frame broadphase update (documented on [`Batch::update`]): a thin public layer
+//! over the engine, whose sink is the fat boxes and the moved set.
 
 mod large;
 mod moved;
 
 use crate::aabb::Aabb3;
-use crate::batch::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use crate::batch::{Batch, BatchError, BoxSink, BoxSource, Maps};
-use crate::block;
-use crate::extended;
+use crate::batch::Batch;
+use crate::engine::{Active, AosRun, AosSink, Engine, Poses, Sink, Tight};
+use crate::error::BatchError;
+use crate::fat::Margin;
 use crate::lane::Vector;
+use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
-use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::Simd3Job;
-use crate::transform::{Class, Transform3};
+use crate::simd::{self, LaneArray};
+use crate::transform::Transform3;
 
-pub use crate::fat::Margin;
 pub use large::{LargePose, LargeRigid3};
 pub use moved::Moved;
 
 use glam::DVec3;
-
-/// The objects an update visits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Active<'a> {
-    /// Every object.
-    All,
-    /// The objects at these indices, strictly ascending.
-    Indices(&'a [u32]),
-    /// The objects whose bit is set: bit `i % 64` of word `i / 64`, with `len.div_ceil(64)`
-    /// words and no bit at or past `len`.
-    Mask(&'a [u64]),
-}
 
 /// Two poses per object, the current and the predicted one: the tight box is the union of
 /// the boxes at both (the swept box of continuous collision detection), computed in the
@@ -61,95 +49,8 @@ pub struct LargeWorld<'a, T> {
 
 /// Poses an update reads: any [`TransformSource`](crate::TransformSource), a [`Swept`]
 /// pair of them, or a [`LargeWorld`].
-pub trait PoseSource<const N: usize>: sealed::Poses<N> {}
-impl<const N: usize, P: sealed::Poses<N>> PoseSource<N> for P {}
-
-pub(crate) mod sealed {
-    //! What a pose source must do: tight boxes in lanes, and one at a time on the
-    //! extended path.
-
-    use super::*;
-
-    /// Tight world boxes from local boxes.
-    pub trait Poses<const N: usize> {
-        /// Refuses a pose count other than `len` (a shared pose has none).
-        fn check_len(&self, len: usize) -> Result<(), BatchError>;
-        /// The tight boxes of objects `i..i + count` from their local boxes in lanes, and a
-        /// lane value that is 0 where the result stands and nonzero where the object must
-        /// be recomputed by [`Poses::tight_one`].
-        fn tight<L: LaneArray>(
-            &self,
-            i: usize,
-            count: usize,
-            lo: Vector<L, N>,
-            hi: Vector<L, N>,
-            method: Method,
-            outward: bool,
-        ) -> (Vector<L, N>, Vector<L, N>, L);
-        /// The tight box of object `i` on the extended path, which takes every input.
-        fn tight_one(
-            &self,
-            i: usize,
-            lo: [f32; N],
-            hi: [f32; N],
-            method: Method,
-            rounding: Rounding,
-        ) -> [[f32; N]; 2];
-        /// Asks for object `i`'s poses ahead of a scattered access.
-        fn prefetch(&self, i: usize) {
-            let _ = i;
-        }
-        /// Runs an update of AoS 3D boxes on the single-box kernel and returns true, or
-        /// returns false where these poses or the backend have none.
-        fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
-            let _ = (update, backend);
-            false
-        }
-    }
-}
-
-use sealed::Poses;
-
-impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
-    fn check_len(&self, len: usize) -> Result<(), BatchError> {
-        match self.len()? {
-            Some(found) => BatchError::check_len("poses", len, found),
-            None => Ok(()),
-        }
-    }
-    #[inline(always)]
-    fn tight<L: LaneArray>(
-        &self,
-        i: usize,
-        count: usize,
-        lo: Vector<L, N>,
-        hi: Vector<L, N>,
-        method: Method,
-        outward: bool,
-    ) -> (Vector<L, N>, Vector<L, N>, L) {
-        block::transform(&self.load::<L>(i, count), lo, hi, method, outward)
-    }
-    fn tight_one(
-        &self,
-        i: usize,
-        lo: [f32; N],
-        hi: [f32; N],
-        _: Method,
-        rounding: Rounding,
-    ) -> [[f32; N]; 2] {
-        let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
-        [min, max]
-    }
-    fn prefetch(&self, i: usize) {
-        ReadMaps::prefetch(self, i);
-    }
-    fn update_aos3(&self, update: AosUpdate<'_>, backend: Backend) -> bool {
-        match self.maps() {
-            Some(maps) => X::Class::run_simd3(AosUpdateOn { maps, update }, backend),
-            None => false,
-        }
-    }
-}
+pub trait PoseSource<const N: usize>: Poses<N> {}
+impl<const N: usize, P: Poses<N>> PoseSource<N> for P {}
 
 impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
@@ -325,372 +226,61 @@ impl Batch {
         if len as u64 > u64::from(u32::MAX) + 1 {
             return Err(BatchError::TooManyObjects(len));
         }
-        check_active(active, len)?;
+        active.check(len)?;
         moved.reset(len);
-        if let (false, Some(local), Some(fat)) =
+        if let (false, Some(boxes), Some(fat)) =
             (self.is_deterministic(), local.aabb3s(), fat.aabb3s_mut())
         {
-            let update = AosUpdate {
-                local,
-                fat,
+            let run = AosRun {
+                local: boxes,
+                sink: AosFat {
+                    fat,
+                    margin,
+                    moved: &mut *moved,
+                },
                 active,
-                moved: &mut *moved,
-                margin,
                 method: self.method,
                 rounding: self.rounding,
             };
-            if poses.update_aos3(update, self.backend()) {
+            if poses.run_aos(run, self.backend()) {
                 return Ok(());
             }
         }
-        let update = Update {
+        let engine = Engine {
             local,
             poses,
-            fat,
+            sink: Fat { fat, margin, moved },
             len,
+            active,
             method: self.method,
             rounding: self.rounding,
-            margin,
-            active,
-            moved,
         };
-        simd::dispatch(self.backend(), !self.is_deterministic(), update);
+        engine.run(self.backend(), !self.is_deterministic());
         Ok(())
     }
 }
 
-/// An update of AoS 3D boxes, its inputs checked: run on the single-box kernel, since
-/// gathering AoS boxes into lanes costs more than the kernel (as for
-/// [`Batch::transform`]).
-pub(crate) struct AosUpdate<'a> {
-    local: &'a [Aabb3],
-    fat: &'a mut [Aabb3],
-    active: Active<'a>,
-    moved: &'a mut Moved,
-    margin: Margin,
-    method: Method,
-    rounding: Rounding,
-}
-
-/// An [`AosUpdate`] with its poses, one per box or shared.
-struct AosUpdateOn<'a, T> {
-    maps: Maps<'a, T>,
-    update: AosUpdate<'a>,
-}
-
-impl<T> Simd3Job<T> for AosUpdateOn<'_, T> {
-    fn run(self, backend: Backend) -> bool
-    where
-        T: Transform3,
-    {
-        if let Backend::Scalar | Backend::Wide = backend {
-            return false;
-        }
-        // One loop per method and rounding, each specialised to its kernel.
-        let u = &self.update;
-        match (u.method, u.rounding) {
-            (Method::Naive, Rounding::Nearest) => self.objects(Method::Naive, Rounding::Nearest),
-            (Method::Naive, Rounding::Outward) => self.objects(Method::Naive, Rounding::Outward),
-            (Method::AbsMatrix, Rounding::Nearest) => {
-                self.objects(Method::AbsMatrix, Rounding::Nearest)
-            }
-            (Method::AbsMatrix, Rounding::Outward) => {
-                self.objects(Method::AbsMatrix, Rounding::Outward)
-            }
-            (Method::SignSelect, Rounding::Nearest) => {
-                self.objects(Method::SignSelect, Rounding::Nearest)
-            }
-            (Method::SignSelect, Rounding::Outward) => {
-                self.objects(Method::SignSelect, Rounding::Outward)
-            }
-        }
-        true
-    }
-}
-
-impl<T: Transform3> AosUpdateOn<'_, T> {
-    /// Every active object through [`Aabb3::transformed`], its fat box compared and
-    /// rewritten on `Vec3A` (the same arithmetic, so the same bits, as the lanes).
-    #[inline(always)]
-    fn objects(self, method: Method, rounding: Rounding) {
-        let AosUpdate {
-            local,
-            fat,
-            active,
-            moved,
-            margin,
-            ..
-        } = self.update;
-        // Method calls rather than closures: a closure here was compiled out of line, with
-        // the method and rounding as run-time values instead of constants.
-        let job = Chunk {
-            local,
-            maps: self.maps,
-            margin,
-            method,
-            rounding,
-        };
-        // Scattered objects: their lines are requested `AHEAD` objects in advance.
-        let ahead = |fat: &[Aabb3], i: usize| {
-            simd::prefetch(&local[i]);
-            simd::prefetch(&fat[i]);
-            simd::prefetch(job.pose(i));
-        };
-        let mut early = ActiveIndices::new(active);
-        early.by_ref().take(AHEAD).for_each(|i| ahead(fat, i));
-        match active {
-            Active::All => job.run(0, local.len(), fat, moved),
-            Active::Indices(ix) => {
-                for &i in ix {
-                    if let Some(j) = early.next() {
-                        ahead(fat, j);
-                    }
-                    job.one(i as usize, fat, moved);
-                }
-            }
-            Active::Mask(words) => {
-                for (w, &word) in words.iter().enumerate() {
-                    if word == u64::MAX {
-                        // A run: the hardware prefetcher follows it; the lookahead skips it.
-                        job.run(64 * w, 64 * w + 64, fat, moved);
-                        early.nth(63);
-                        continue;
-                    }
-                    let mut bits = word;
-                    while bits != 0 {
-                        if let Some(j) = early.next() {
-                            ahead(fat, j);
-                        }
-                        job.one(64 * w + bits.trailing_zeros() as usize, fat, moved);
-                        bits &= bits - 1;
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// The AoS update's kernel: the method and rounding are constants at each call site.
-struct Chunk<'a, T> {
-    local: &'a [Aabb3],
-    maps: Maps<'a, T>,
-    margin: Margin,
-    method: Method,
-    rounding: Rounding,
-}
-
-impl<T: Transform3> Chunk<'_, T> {
-    #[inline(always)]
-    fn pose(&self, i: usize) -> &T {
-        match self.maps {
-            Maps::Each(poses) => &poses[i],
-            Maps::Shared(pose) => pose,
-        }
-    }
-
-    /// Object `i` alone (a scattered object).
-    #[inline(always)]
-    fn one(&self, i: usize, fat: &mut [Aabb3], moved: &mut Moved) {
-        let tight = self.local[i].transformed(self.pose(i), self.method, self.rounding);
-        if !crate::fat::inside_aabb3(&tight, &fat[i]) {
-            fat[i] = tight.fattened(self.margin);
-            moved.record(i, 1);
-        }
-    }
-
-    /// Objects `start..end` eight at a time: the tight boxes and the mask of those that
-    /// left their fat boxes, then a loop over its set bits. A branch per object would
-    /// mispredict on every object a walk moves at random; the loop mispredicts once a
-    /// chunk.
-    #[inline(always)]
-    fn run(&self, start: usize, end: usize, fat: &mut [Aabb3], moved: &mut Moved) {
-        let chunks = self.local[start..end]
-            .chunks(8)
-            .zip(fat[start..end].chunks_mut(8));
-        for (c, (local, fat)) in chunks.enumerate() {
-            let base = start + 8 * c;
-            let mut tight = [Aabb3::EMPTY; 8];
-            let mut left = 0;
-            for (k, (l, f)) in local.iter().zip(&*fat).enumerate() {
-                tight[k] = l.transformed(self.pose(base + k), self.method, self.rounding);
-                left |= u32::from(!crate::fat::inside_aabb3(&tight[k], f)) << k;
-            }
-            let mut bits = left;
-            while bits != 0 {
-                let k = bits.trailing_zeros() as usize;
-                fat[k] = tight[k].fattened(self.margin);
-                bits &= bits - 1;
-            }
-            moved.record(base, left);
-        }
-    }
-}
-
-/// How many scattered objects ahead the update requests memory.
-const AHEAD: usize = 16;
-
-/// The indices of an index list or a mask, ascending.
-struct ActiveIndices<'a> {
-    active: Active<'a>,
-    /// The next position in the list, or the current mask word.
-    at: usize,
-    /// The bits of the current mask word not yet visited.
-    bits: u64,
-}
-
-impl<'a> ActiveIndices<'a> {
-    fn new(active: Active<'a>) -> Self {
-        let bits = match active {
-            Active::Mask(words) => words.first().copied().unwrap_or(0),
-            _ => 0,
-        };
-        Self {
-            active,
-            at: 0,
-            bits,
-        }
-    }
-}
-
-impl Iterator for ActiveIndices<'_> {
-    type Item = usize;
-    #[inline(always)]
-    fn next(&mut self) -> Option<usize> {
-        match self.active {
-            Active::All => None,
-            Active::Indices(ix) => {
-                let i = *ix.get(self.at)?;
-                self.at += 1;
-                Some(i as usize)
-            }
-            Active::Mask(words) => {
-                while self.bits == 0 {
-                    self.at += 1;
-                    self.bits = *words.get(self.at)?;
-                }
-                let i = 64 * self.at + self.bits.trailing_zeros() as usize;
-                self.bits &= self.bits - 1;
-                Some(i)
-            }
-        }
-    }
-}
-
-/// Refuses indices out of range or out of order, and masks of the wrong shape.
-fn check_active(active: Active<'_>, len: usize) -> Result<(), BatchError> {
-    let refuse = |why| Err(BatchError::InvalidActive(why));
-    match active {
-        Active::All => Ok(()),
-        Active::Indices(ix) => {
-            if ix.last().is_some_and(|&i| i as usize >= len) {
-                return refuse("an index is past the last object");
-            }
-            if ix.windows(2).any(|w| w[0] >= w[1]) {
-                return refuse("the indices are not strictly ascending");
-            }
-            Ok(())
-        }
-        Active::Mask(words) => {
-            if words.len() != len.div_ceil(64) {
-                return refuse("the mask does not have len.div_ceil(64) words");
-            }
-            let tail = len % 64;
-            if tail != 0 && words.last().is_some_and(|w| w >> tail != 0) {
-                return refuse("the mask has a bit past the last object");
-            }
-            Ok(())
-        }
-    }
-}
-
-/// The update as a job for the dispatcher.
-struct Update<'a, const N: usize, B, P, F> {
-    local: B,
-    poses: P,
+/// The update's sink in lanes: each tight box compared with its fat box, the fat boxes it
+/// left rewritten, and their objects recorded.
+struct Fat<'a, F> {
     fat: F,
-    len: usize,
-    method: Method,
-    rounding: Rounding,
     margin: Margin,
-    active: Active<'a>,
     moved: &'a mut Moved,
 }
 
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Job
-    for Update<'_, N, B, P, F>
-{
-    /// One loop per method, as in [`Batch::transform`].
+impl<const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'_, F> {
     #[inline(always)]
-    fn run<L: LaneArray>(mut self) {
-        let outward = self.rounding == Rounding::Outward;
-        match self.method {
-            Method::Naive => self.visit::<L>(Method::Naive, outward),
-            Method::AbsMatrix => self.visit::<L>(Method::AbsMatrix, outward),
-            Method::SignSelect => self.visit::<L>(Method::SignSelect, outward),
-        }
-    }
-}
-
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, N, B, P, F> {
-    /// The active objects in aligned lane blocks: a block with more than one active lane
-    /// runs in lanes (its inactive lanes are computed and ignored), a lone active object
-    /// and the tail run one lane of the same arithmetic (one call site of each, so that
-    /// the kernels are inlined twice per method, as in [`Batch::transform`]).
-    #[inline(always)]
-    fn visit<L: LaneArray>(&mut self, method: Method, outward: bool) {
-        // Scattered objects: their lines are requested `AHEAD` objects in advance.
-        let scattered = !matches!(self.active, Active::All);
-        let mut early = ActiveIndices::new(self.active);
-        early.by_ref().take(AHEAD).for_each(|i| self.prefetch(i));
-        for (start, count, active) in Blocks::new(self.active, self.len, L::WIDTH) {
-            let ones = active.count_ones() as usize;
-            if scattered && ones < count {
-                for _ in 0..ones {
-                    if let Some(i) = early.next() {
-                        self.prefetch(i);
-                    }
-                }
-            } else if scattered {
-                // A whole block: a run the hardware prefetcher follows; the lookahead skips it.
-                early.nth(ones - 1);
-            }
-            if count == L::WIDTH && active & (active - 1) != 0 {
-                self.block::<L>(start, L::WIDTH, active, method, outward);
-            } else {
-                let mut bits = active;
-                while bits != 0 {
-                    let k = bits.trailing_zeros() as usize;
-                    self.block::<L::One>(start + k, 1, 1, method, outward);
-                    bits &= bits - 1;
-                }
-            }
-        }
-    }
-
-    /// Asks for object `i`'s local box, poses and fat box.
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        self.local.prefetch(i);
-        self.poses.prefetch(i);
-        self.fat.read().prefetch(i);
-    }
-
-    /// Objects `i..i + count`, of which the `lanes` bits are active: the tight boxes in
-    /// lanes, the fat boxes they leave rewritten, and the lanes that do not stand redone
-    /// one at a time on the extended path.
-    #[inline(always)]
-    fn block<L: LaneArray>(
+    fn span<L: LaneArray>(
         &mut self,
         i: usize,
         count: usize,
-        lanes: u32,
-        method: Method,
-        outward: bool,
+        lanes: u64,
+        tight: [Vector<L, N>; 2],
+        stands: L,
+        redo: impl Fn(usize) -> [[f32; N]; 2],
     ) {
-        let (lo, hi) = self.local.load::<L>(i, count);
-        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
-        let outside = crate::fat::outside(min, max, fat_min, fat_max);
+        let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
         // The common case, every box inside its fat box and standing: one reduction.
         if !(outside + stands).any_nonzero() {
             return;
@@ -699,40 +289,47 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
             i,
             count,
             lanes,
-            method,
             [outside, stands],
-            [min, max],
+            tight,
             [fat_min, fat_max],
+            redo,
         );
     }
+    fn prefetch(&self, i: usize) {
+        self.fat.read().prefetch(i);
+    }
+}
 
-    /// The rest of a block where a box left its fat box or did not stand: the fat boxes
+impl<F> Fat<'_, F> {
+    /// The rest of a span where a box left its fat box or did not stand: the fat boxes
     /// rewritten and the objects recorded. Out of line: inlined, its code (though rarely
     /// run) made LLVM spill the hot path, which then ran three times slower. It uses no
     /// multiply-add, so it needs none of the dispatcher's target features.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    fn rewrite<L: LaneArray>(
+    fn rewrite<L: LaneArray, const N: usize>(
         &mut self,
         i: usize,
         count: usize,
-        lanes: u32,
-        method: Method,
+        lanes: u64,
         [outside, stands]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
-    ) {
-        let redo = stands.nonzero_mask() & lanes;
-        let left = outside.nonzero_mask() & lanes & !redo;
+        redo: impl Fn(usize) -> [[f32; N]; 2],
+    ) where
+        F: WriteBoxes<N>,
+    {
+        let redo_lanes = u64::from(stands.nonzero_mask()) & lanes;
+        let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
         if left != 0 {
-            // The whole block is stored, the lanes that stay with their own bits: lanes
+            // The whole span is stored, the lanes that stay with their own bits: lanes
             // picked by a dynamic index would pin the vectors to memory and stop LLVM from
-            // vectorising the block.
+            // vectorising the span.
             let (grown_min, grown_max) = self.margin.grow(min, max);
             // Negative where the box is rewritten. `outside` is 0 where a box stays and at
             // least 1 where it left, so where every lane is active and stands its negation
             // is the mask; otherwise it is built lane by lane.
-            let keep = if left == outside.nonzero_mask() {
+            let keep = if left == u64::from(outside.nonzero_mask()) {
                 -outside
             } else {
                 let mut keep = L::splat(0.0);
@@ -749,10 +346,10 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
             self.fat.store(i, count, min, max);
         }
         let mut moved = left;
-        let mut bits = redo;
+        let mut bits = redo_lanes;
         while bits != 0 {
             let k = bits.trailing_zeros() as usize;
-            if self.redo(i + k, method) {
+            if self.redo(i + k, redo(i + k)) {
                 moved |= 1 << k;
             }
             bits &= bits - 1;
@@ -760,11 +357,13 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
         self.moved.record(i, moved);
     }
 
-    /// Object `i` on the extended path; true when its fat box was rewritten.
+    /// Object `i`'s tight box from the extended path; true when it left its fat box,
+    /// which is then rewritten.
     #[cold]
-    fn redo(&mut self, i: usize, method: Method) -> bool {
-        let (lo, hi) = self.local.get(i);
-        let tight = self.poses.tight_one(i, lo, hi, method, self.rounding);
+    fn redo<const N: usize>(&mut self, i: usize, tight: [[f32; N]; 2]) -> bool
+    where
+        F: WriteBoxes<N>,
+    {
         if crate::fat::inside(tight, self.fat.read().get(i).into()) {
             return false;
         }
@@ -776,79 +375,51 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, F: WriteBoxes<N>> Update<'_, 
     }
 }
 
-/// The active objects in aligned blocks of `width` (1, 8 or 16) lanes, ascending:
-/// `(start, count, active)` with `start` a multiple of `width`, `count` the lanes that
-/// exist (`width`, or fewer in the last block) and `active` the nonzero mask of the active
-/// ones. Empty mask words are skipped whole.
-struct Blocks<'a> {
-    active: Active<'a>,
-    len: usize,
-    width: usize,
-    /// The next block's start, or the next position in an index list.
-    at: usize,
+/// The update's sink on the AoS loop: the fat boxes as AoS 3D boxes.
+struct AosFat<'a> {
+    fat: &'a mut [Aabb3],
+    margin: Margin,
+    moved: &'a mut Moved,
 }
 
-impl<'a> Blocks<'a> {
-    fn new(active: Active<'a>, len: usize, width: usize) -> Self {
-        Self {
-            active,
-            len,
-            width,
-            at: 0,
+impl AosSink for AosFat<'_> {
+    /// Eight objects at a time: the tight boxes and the mask of those that left their fat
+    /// boxes, then a loop over its set bits. A branch per object would mispredict on every
+    /// object a walk moves at random; the loop mispredicts once per eight.
+    #[inline(always)]
+    fn run<'p, T: Transform3 + 'p>(
+        &mut self,
+        start: usize,
+        local: &[Aabb3],
+        mut poses: impl Iterator<Item = &'p T>,
+        tight: Tight,
+    ) {
+        let fat = &mut self.fat[start..start + local.len()];
+        for (c, (local, fat)) in local.chunks(8).zip(fat.chunks_mut(8)).enumerate() {
+            let mut boxes = [Aabb3::EMPTY; 8];
+            let mut left = 0;
+            let objects = local.iter().zip(&*fat).zip(poses.by_ref());
+            for (k, ((l, f), pose)) in objects.enumerate() {
+                boxes[k] = tight.of(l, pose);
+                left |= u64::from(!crate::fat::inside_aabb3(&boxes[k], f)) << k;
+            }
+            let mut bits = left;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                fat[k] = boxes[k].fattened(self.margin);
+                bits &= bits - 1;
+            }
+            self.moved.record(start + 8 * c, left);
         }
     }
-
-    /// The lanes of the block at `start`, and the mask of all of them.
     #[inline(always)]
-    fn lanes(&self, start: usize) -> (usize, u32) {
-        let count = self.width.min(self.len - start);
-        (count, (((1u64 << count) - 1) as u32))
-    }
-}
-
-impl Iterator for Blocks<'_> {
-    type Item = (usize, usize, u32);
-    #[inline(always)]
-    fn next(&mut self) -> Option<(usize, usize, u32)> {
-        match self.active {
-            Active::All => {
-                let start = self.at;
-                if start >= self.len {
-                    return None;
-                }
-                self.at += self.width;
-                let (count, all) = self.lanes(start);
-                Some((start, count, all))
-            }
-            Active::Mask(words) => loop {
-                let start = self.at;
-                if start >= self.len {
-                    return None;
-                }
-                // Straight to the block of the next set bit, a whole empty word at a time.
-                let word = words[start / 64];
-                let rest = word >> (start % 64);
-                if rest == 0 {
-                    self.at = (start / 64 + 1) * 64;
-                    continue;
-                }
-                let next = start + rest.trailing_zeros() as usize;
-                let block = next - next % self.width;
-                self.at = block + self.width;
-                let (count, all) = self.lanes(block);
-                return Some((block, count, (word >> (block % 64)) as u32 & all));
-            },
-            Active::Indices(ix) => {
-                let first = *ix.get(self.at)? as usize;
-                let start = first - first % self.width;
-                let (count, _) = self.lanes(start);
-                let mut active = 0;
-                while let Some(&i) = ix.get(self.at).filter(|&&i| (i as usize) < start + count) {
-                    active |= 1 << (i as usize - start);
-                    self.at += 1;
-                }
-                Some((start, count, active))
-            }
+    fn one(&mut self, i: usize, tight: Aabb3) {
+        if !crate::fat::inside_aabb3(&tight, &self.fat[i]) {
+            self.fat[i] = tight.fattened(self.margin);
+            self.moved.record(i, 1);
         }
+    }
+    fn prefetch(&self, i: usize) {
+        simd::prefetch(&self.fat[i]);
     }
 }

@@ -65,14 +65,15 @@ impl Moved {
         self.indices.clear();
     }
 
-    /// Adds objects `i + k` for every bit `k` of `bits`; `i` is a multiple of the lane
-    /// width, so the bits never straddle two words, and calls come in ascending `i`.
+    /// Adds objects `i + k` for every bit `k` of `bits`; `i` is the start of a span, a
+    /// multiple of its width, so the bits never straddle two words, and calls come in
+    /// ascending order of their objects.
     #[inline(always)]
-    pub(crate) fn record(&mut self, i: usize, mut bits: u32) {
+    pub(crate) fn record(&mut self, i: usize, mut bits: u64) {
         if bits == 0 {
             return;
         }
-        self.words[i / 64] |= u64::from(bits) << (i % 64);
+        self.words[i / 64] |= bits << (i % 64);
         while bits != 0 {
             self.indices
                 .push((i + bits.trailing_zeros() as usize) as u32);

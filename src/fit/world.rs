@@ -27,9 +27,9 @@ use glam::{DMat3, DVec3, Mat3A, Vec3A};
 use super::bound::Bounded;
 use super::{Capsule, Obb3, Sphere};
 use crate::aabb::Aabb3;
-use crate::batch::BatchError;
-use crate::batch::TransformSource;
+use crate::error::BatchError;
 use crate::extended::ExtendedMap;
+use crate::layout::TransformSource;
 use crate::method::Rounding;
 use crate::transform::{Class, Similarity3, Transform3};
 

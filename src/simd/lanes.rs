@@ -14,7 +14,7 @@ pub trait LaneArray: Lane {
     /// The number of lanes.
     const WIDTH: usize;
     /// One lane with the same arithmetic (fused exactly when `Self` fuses): the lane type
-    /// of the last, partial block, so that every box is rounded the same wherever it sits.
+    /// of the last, partial span, so that every box is rounded the same wherever it sits.
     type One: LaneArray;
     /// Lane `k`.
     fn get(&self, k: usize) -> f32;

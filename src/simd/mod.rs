@@ -92,7 +92,7 @@ impl Backend {
         fastest()
     }
 
-    /// Boxes per lane block.
+    /// Boxes per lane vector: the width of the engine's spans.
     #[must_use]
     pub const fn lanes(self) -> usize {
         match self {

@@ -150,7 +150,7 @@ impl From<Similarity3> for Trs3 {
 
 /// `R(q)·diag(s)` as glam columns, rounded as the kernels round `R(q)`.
 fn affine(q: Quat, scale: Vec3A, translation: Vec3A) -> Affine3A {
-    let (cols, _) = kernel::rotation(q.to_array());
+    let (cols, _) = kernel::rotation(q.to_array(), 1.0);
     let col = |j: usize| Vec3A::from_array(cols[j]) * scale[j];
     Affine3A {
         matrix3: Mat3A::from_cols(col(0), col(1), col(2)),
@@ -223,7 +223,7 @@ fn quat_lanes<L: Lane, const SCALED: bool>(
     f: &[L; MAX_FIELDS],
     scale: Vector<L, 3>,
 ) -> QuatLanes<Vector<L, 3>, SCALED> {
-    let (cols, rho) = kernel::rotation([f[0], f[1], f[2], f[3]]);
+    let (cols, rho) = kernel::rotation([f[0], f[1], f[2], f[3]], L::splat(1.0));
     QuatLanes {
         cols: [Vector(cols[0]), Vector(cols[1]), Vector(cols[2])],
         rho: Vector([rho; 3]),

@@ -71,6 +71,7 @@
 //! by the radii plus `‖L‖₁·(δ_a + m·δ_b + |w|) <= ‖L‖₁·P`, and the `f64` evaluation errs by
 //! far less than the second term.
 
+use crate::kernel;
 use crate::num::{pow2, round_up, sqrt};
 use glam::{DMat3, DVec3, Quat, Vec3A};
 
@@ -78,18 +79,10 @@ use crate::transform::{Rigid3, Similarity3};
 
 const U: f64 = pow2(-24);
 
-/// `R(q)` in `f64`, the crate's formula on `q` as stored.
+/// `R(q)` in `f64`: the crate's one formula ([`kernel::rotation`]) on `q` as stored.
 fn rotation(q: Quat) -> DMat3 {
-    let [x, y, z, w] = q.to_array().map(f64::from);
-    let (x2, y2, z2) = (x + x, y + y, z + z);
-    let (xx, yy, zz) = (x * x2, y * y2, z * z2);
-    let (xy, xz, yz) = (x * y2, x * z2, y * z2);
-    let (wx, wy, wz) = (w * x2, w * y2, w * z2);
-    DMat3::from_cols(
-        DVec3::new(1.0 - (yy + zz), xy + wz, xz - wy),
-        DVec3::new(xy - wz, 1.0 - (xx + zz), yz + wx),
-        DVec3::new(xz + wy, yz - wx, 1.0 - (xx + yy)),
-    )
+    let (cols, _) = kernel::rotation(q.to_array().map(f64::from), 1.0);
+    DMat3::from_cols_array_2d(&cols)
 }
 
 /// Which object of a query an error is about.

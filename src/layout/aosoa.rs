@@ -4,9 +4,10 @@
 use alloc::vec::Vec;
 use glam::{Affine2, Affine3A};
 
-use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use super::{BatchError, box_lanes, zero_fields};
+use super::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;

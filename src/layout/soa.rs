@@ -4,9 +4,10 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use super::{BatchError, box_lanes, zero_fields};
+use super::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
+use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;
@@ -225,8 +226,8 @@ fn prefetch_columns(columns: &[&[f32]], i: usize) {
     }
 }
 
-/// Lanes `i..i + count` of every column: one vector load per column for a whole lane
-/// block, lane by lane for the tail.
+/// Lanes `i..i + count` of every column: one vector load per column for a whole span,
+/// lane by lane for the tail.
 #[inline(always)]
 fn gather<L: LaneArray, T: Fields>(
     columns: &T::Array<&[f32]>,

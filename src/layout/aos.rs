@@ -5,10 +5,11 @@
 //! that the lane arrays stay in registers and the main loop, where `count` is the lane
 //! width, has no mask at all.
 
-use super::sealed::{ReadBoxes, ReadMaps, WriteBoxes};
-use super::{BatchError, Maps, box_lanes, zero_fields};
+use super::{Maps, box_lanes, zero_fields};
+use super::{ReadBoxes, ReadMaps, WriteBoxes};
 use crate::aabb::Aabb3;
 use crate::aabb::Boxes;
+use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
 use crate::lane::Vector;
 use crate::simd::LaneArray;

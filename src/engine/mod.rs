@@ -1,0 +1,379 @@
+//! The engine under every batch transform and every broadphase update: the active set,
+//! the lane loop and the AoS loop, from a box source and a pose source into a sink.
+//!
+//! A run reads each active object's local box, computes its tight world box from its pose,
+//! and hands it to a sink: [`Store`] writes it (the batch transform), the broadphase's fat
+//! sink compares it with the fat box and records what moved. Two loops do this:
+//! - [`Engine`], in lanes, for every layout; lanes whose result does not stand are redone
+//!   one at a time on the extended path, and the sink takes those too;
+//! - [`AosRun`], for AoS 3D boxes with AoS or shared poses, on the single-box kernel
+//!   (glam's `Vec3A`), which [`Poses::run_aos`] runs where it applies.
+
+/// `$body` once per method (and per rounding), with `$m` (and `$r`) bound to it as a
+/// constant, so that each copy is specialised to its kernel: the one place the
+/// combinations are spelled out.
+macro_rules! specialise {
+    ($method:expr, |$m:ident| $body:expr) => {
+        match $method {
+            Method::Naive => {
+                let $m = Method::Naive;
+                $body
+            }
+            Method::AbsMatrix => {
+                let $m = Method::AbsMatrix;
+                $body
+            }
+            Method::SignSelect => {
+                let $m = Method::SignSelect;
+                $body
+            }
+        }
+    };
+    ($method:expr, $rounding:expr, |$m:ident, $r:ident| $body:expr) => {
+        match $rounding {
+            Rounding::Nearest => {
+                let $r = Rounding::Nearest;
+                specialise!($method, |$m| $body)
+            }
+            Rounding::Outward => {
+                let $r = Rounding::Outward;
+                specialise!($method, |$m| $body)
+            }
+        }
+    };
+}
+
+mod active;
+mod aos;
+
+pub use active::Active;
+pub(crate) use aos::{AosRun, AosSink, Tight};
+
+use active::{Lookahead, Spans};
+
+use crate::error::BatchError;
+use crate::extended;
+use crate::kernel;
+use crate::lane::Vector;
+use crate::layout::{ReadBoxes, ReadMaps, WriteBoxes};
+use crate::method::{Method, Rounding};
+use crate::simd::{self, Backend, Job, LaneArray};
+use crate::transform::Class;
+
+/// Tight world boxes from local boxes: any transform source, and the broadphase's pose
+/// pairs and large-world poses.
+pub(crate) trait Poses<const N: usize> {
+    /// Refuses a pose count other than `len` (a shared pose has none).
+    fn check_len(&self, len: usize) -> Result<(), BatchError>;
+    /// The tight boxes of objects `i..i + count` from their local boxes in lanes, and a
+    /// lane value that is 0 where the result stands and nonzero where the object must be
+    /// recomputed by [`Poses::tight_one`].
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        lo: Vector<L, N>,
+        hi: Vector<L, N>,
+        method: Method,
+        outward: bool,
+    ) -> (Vector<L, N>, Vector<L, N>, L);
+    /// The tight box of object `i` on the extended path, which takes every input.
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; N],
+        hi: [f32; N],
+        method: Method,
+        rounding: Rounding,
+    ) -> [[f32; N]; 2];
+    /// Asks for object `i`'s poses ahead of a scattered access.
+    fn prefetch(&self, i: usize) {
+        let _ = i;
+    }
+    /// Runs `run` (AoS 3D boxes) on the single-box kernel and returns true, or returns
+    /// false where these poses or the backend have none.
+    fn run_aos<S: AosSink>(&self, run: AosRun<'_, S>, backend: Backend) -> bool {
+        let _ = (run, backend);
+        false
+    }
+}
+
+impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
+    fn check_len(&self, len: usize) -> Result<(), BatchError> {
+        match self.len()? {
+            Some(found) => BatchError::check_len("poses", len, found),
+            None => Ok(()),
+        }
+    }
+    #[inline(always)]
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        lo: Vector<L, N>,
+        hi: Vector<L, N>,
+        method: Method,
+        outward: bool,
+    ) -> (Vector<L, N>, Vector<L, N>, L) {
+        kernel::transform_checked(&self.load::<L>(i, count), lo, hi, method, outward)
+    }
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; N],
+        hi: [f32; N],
+        _: Method,
+        rounding: Rounding,
+    ) -> [[f32; N]; 2] {
+        let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
+        [min, max]
+    }
+    fn prefetch(&self, i: usize) {
+        ReadMaps::prefetch(self, i);
+    }
+    fn run_aos<S: AosSink>(&self, run: AosRun<'_, S>, backend: Backend) -> bool {
+        match self.maps() {
+            Some(maps) => X::Class::run_simd3(run.with(maps), backend),
+            None => false,
+        }
+    }
+}
+
+/// Where the lane loop's tight boxes go.
+pub(crate) trait Sink<const N: usize> {
+    /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
+    /// `lanes` bits are active. Where `stands` is nonzero the lane's box must be replaced
+    /// by `redo(i + k)`, its box on the extended path.
+    fn span<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        tight: [Vector<L, N>; 2],
+        stands: L,
+        redo: impl Fn(usize) -> [[f32; N]; 2],
+    );
+    /// Asks for object `i`'s output ahead of a scattered access.
+    fn prefetch(&self, i: usize) {
+        let _ = i;
+    }
+    /// After the last span (a fence after streaming stores).
+    fn finish(&mut self) {}
+}
+
+/// The plain sink: every tight box written to `out`, past the caches when `stream` is set.
+pub(crate) struct Store<O> {
+    /// The boxes written.
+    pub out: O,
+    /// Store whole AoSoA blocks past the caches, and fence at the end.
+    pub stream: bool,
+}
+
+impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
+    #[inline(always)]
+    fn span<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        [min, max]: [Vector<L, N>; 2],
+        stands: L,
+        redo: impl Fn(usize) -> [[f32; N]; 2],
+    ) {
+        // Every object is active: a store writes whole spans.
+        debug_assert_eq!(lanes.count_ones() as usize, count);
+        if self.stream {
+            self.out.store_streaming(i, count, min, max);
+        } else {
+            self.out.store(i, count, min, max);
+        }
+        // The rare lanes that do not stand are recomputed from the source data; nothing
+        // here takes `&mut self` out of line, so the layout descriptors stay in registers.
+        if stands.any_nonzero() {
+            for k in 0..count {
+                if stands.get(k) != 0.0 {
+                    let [min, max] = redo(i + k);
+                    self.out.set(i + k, min, max);
+                }
+            }
+        }
+    }
+    fn finish(&mut self) {
+        if self.stream {
+            simd::store_fence();
+        }
+    }
+}
+
+/// One run of the engine, its lengths and its active set checked.
+pub(crate) struct Engine<'a, const N: usize, B, P, S> {
+    /// The local boxes.
+    pub local: B,
+    /// The poses.
+    pub poses: P,
+    /// Where the tight boxes go.
+    pub sink: S,
+    /// The number of objects.
+    pub len: usize,
+    /// The objects visited.
+    pub active: Active<'a>,
+    /// The method.
+    pub method: Method,
+    /// The rounding.
+    pub rounding: Rounding,
+}
+
+impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
+    /// Runs in lanes on `backend` (`fused` lets the lanes fuse multiply-adds).
+    ///
+    /// The active set picks the loop before the dispatch, so that each job holds only
+    /// what its loop reads: compiled beside the scattered walk, whose closures borrow the
+    /// whole run, the plain loop reloaded the layouts' pointers on every span.
+    #[inline(always)]
+    pub fn run(self, backend: Backend, fused: bool) {
+        match self.split() {
+            (Active::All, run) => simd::dispatch(backend, fused, Every(run)),
+            (active, run) => simd::dispatch(backend, fused, Scattered { run, active }),
+        }
+    }
+
+    /// [`Engine::run`] in lanes of type `L`, without the dispatch.
+    #[cfg(test)]
+    pub fn run_in<L: LaneArray>(self) {
+        match self.split() {
+            (Active::All, run) => Job::run::<L>(Every(run)),
+            (active, run) => Job::run::<L>(Scattered { run, active }),
+        }
+    }
+
+    /// The active set, and the rest of the run.
+    #[inline(always)]
+    fn split(self) -> (Active<'a>, Run<N, B, P, S>) {
+        let run = Run {
+            local: self.local,
+            poses: self.poses,
+            sink: self.sink,
+            len: self.len,
+            method: self.method,
+            rounding: self.rounding,
+        };
+        (self.active, run)
+    }
+}
+
+/// A run without its active set.
+struct Run<const N: usize, B, P, S> {
+    local: B,
+    poses: P,
+    sink: S,
+    len: usize,
+    method: Method,
+    rounding: Rounding,
+}
+
+/// Every object: the job of [`Active::All`].
+struct Every<const N: usize, B, P, S>(Run<N, B, P, S>);
+
+/// The objects of a list or a mask.
+struct Scattered<'a, const N: usize, B, P, S> {
+    run: Run<N, B, P, S>,
+    active: Active<'a>,
+}
+
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, B, P, S> {
+    /// One loop per method, so that each is specialised to its kernel; the rounding is a
+    /// loop-invariant branch (specialising it too doubled the code, and the build time of
+    /// every call site, for no measurable speed).
+    #[inline(always)]
+    fn run<L: LaneArray>(self) {
+        let mut run = self.0;
+        let outward = run.rounding == Rounding::Outward;
+        specialise!(run.method, |method| run.every::<L>(method, outward));
+        run.sink.finish();
+    }
+}
+
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Scattered<'_, N, B, P, S> {
+    /// As for [`Every`].
+    #[inline(always)]
+    fn run<L: LaneArray>(self) {
+        let (mut run, active) = (self.run, self.active);
+        let outward = run.rounding == Rounding::Outward;
+        specialise!(run.method, |method| {
+            run.spans::<L>(active, method, outward)
+        });
+        run.sink.finish();
+    }
+}
+
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Run<N, B, P, S> {
+    /// Every object: a plain loop over whole spans, then the tail one lane at a time.
+    /// Walking [`Spans`] here measured up to 1.5x slower on cheap kernels in cache (the
+    /// per-span decoding and mask tests are not free there).
+    #[inline(always)]
+    fn every<L: LaneArray>(&mut self, method: Method, outward: bool) {
+        let (w, mut i) = (L::WIDTH, 0);
+        while i + w <= self.len {
+            self.lanes::<L>(i, w, u64::MAX >> (64 - w), method, outward);
+            i += w;
+        }
+        while i < self.len {
+            self.lanes::<L::One>(i, 1, 1, method, outward);
+            i += 1;
+        }
+    }
+
+    /// The active objects in aligned spans of the lane width: a span with more than one
+    /// active object runs in lanes (its inactive lanes are computed and ignored), a lone
+    /// active object and the tail run in one lane of the same arithmetic.
+    #[inline(always)]
+    fn spans<L: LaneArray>(&mut self, active: Active<'_>, method: Method, outward: bool) {
+        let mut ahead = Lookahead::new(active, self.len, |i| self.prefetch(i));
+        for span in Spans::new(active, self.len, L::WIDTH) {
+            ahead.step(span, |i| self.prefetch(i));
+            if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
+                self.lanes::<L>(span.start, L::WIDTH, span.lanes, method, outward);
+            } else {
+                let mut bits = span.lanes;
+                while bits != 0 {
+                    let k = bits.trailing_zeros() as usize;
+                    self.lanes::<L::One>(span.start + k, 1, 1, method, outward);
+                    bits &= bits - 1;
+                }
+            }
+        }
+    }
+
+    /// Asks for object `i`'s local box, poses and output.
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        self.local.prefetch(i);
+        self.poses.prefetch(i);
+        self.sink.prefetch(i);
+    }
+
+    /// Objects `i..i + count` in lanes, into the sink. Inlined into the dispatch wrapper,
+    /// for its target features, except in debug builds: there every inlined copy keeps
+    /// its own stack slots, and the six copies of a [`crate::Swept`] update's two kernels
+    /// needed more than a 2 MiB thread stack. Out of line it computes the same bits (a
+    /// fused multiply-add is correctly rounded with or without the instruction).
+    #[cfg_attr(not(debug_assertions), inline(always))]
+    #[cfg_attr(debug_assertions, inline(never))]
+    fn lanes<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        method: Method,
+        outward: bool,
+    ) {
+        let (lo, hi) = self.local.load::<L>(i, count);
+        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
+        let (local, poses, rounding) = (&self.local, &self.poses, self.rounding);
+        let redo = |j: usize| {
+            let (lo, hi) = local.get(j);
+            poses.tight_one(j, lo, hi, method, rounding)
+        };
+        self.sink.span(i, count, lanes, [min, max], stands, redo);
+    }
+}
