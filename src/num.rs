@@ -3,7 +3,10 @@
 //! `std`), `libm`'s otherwise. Both are correctly rounded where the callers need it
 //! (`sqrt`, `mul_add`, `ceil`, `round`); `hypot` and `sin_cos` feed no bound.
 
-/// `2^k` for `-1022 <= k <= 1023`, exactly.
+/// `2^k` for `-1022 <= k <= 1023`, exactly. Always inlined: at a run-time call site with a
+/// constant `k` it folds to a constant (out of line, every fat box of a broadphase update
+/// paid a call for its `2^-22`).
+#[inline(always)]
 pub(crate) const fn pow2(k: i32) -> f64 {
     assert!(-1022 <= k && k <= 1023);
     f64::from_bits(((k + 1023) as u64) << 52)

@@ -57,6 +57,7 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
         self.current.check_len(len)?;
         self.predicted.check_len(len)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         self.current.prefetch(i);
         self.predicted.prefetch(i);
@@ -106,6 +107,7 @@ impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         BatchError::check_len("poses", len, self.poses.len())
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self.poses[i]);
     }
@@ -295,6 +297,7 @@ impl<const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'_, F> {
             redo,
         );
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
@@ -419,6 +422,7 @@ impl AosSink for AosFat<'_> {
             self.moved.record(i, 1);
         }
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self.fat[i]);
     }

@@ -157,8 +157,31 @@ const AHEAD: usize = 16;
 /// objects in advance. Runs of whole spans are left to the hardware prefetcher, and so is
 /// every object of [`Active::All`].
 pub(crate) struct Lookahead<'a> {
-    /// The active objects one at a time (spans of width 1); `None` for [`Active::All`].
-    next: Option<Spans<'a>>,
+    next: Upcoming<'a>,
+}
+
+/// The active objects one at a time, in order.
+enum Upcoming<'a> {
+    /// [`Active::All`]: none are requested.
+    None,
+    /// An index list's own entries: a list needs no decoding, and its walk one object at
+    /// a time is the hot loop of a sparse update (decoded as spans of one object, it put a
+    /// division by the span width in that loop).
+    List(core::slice::Iter<'a, u32>),
+    /// A mask's objects: its spans of one object.
+    Mask(Spans<'a>),
+}
+
+impl Iterator for Upcoming<'_> {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        match self {
+            Upcoming::None => None,
+            Upcoming::List(ix) => ix.next().map(|&i| i as usize),
+            Upcoming::Mask(spans) => spans.next().map(|s| s.start),
+        }
+    }
 }
 
 impl<'a> Lookahead<'a> {
@@ -166,12 +189,11 @@ impl<'a> Lookahead<'a> {
     #[inline(always)]
     pub fn new(active: Active<'a>, len: usize, mut prefetch: impl FnMut(usize)) -> Self {
         let mut next = match active {
-            Active::All => None,
-            _ => Some(Spans::new(active, len, 1)),
+            Active::All => Upcoming::None,
+            Active::Indices(ix) => Upcoming::List(ix.iter()),
+            Active::Mask(_) => Upcoming::Mask(Spans::new(active, len, 1)),
         };
-        if let Some(objects) = &mut next {
-            objects.take(AHEAD).for_each(|s| prefetch(s.start));
-        }
+        next.by_ref().take(AHEAD).for_each(&mut prefetch);
         Self { next }
     }
 
@@ -179,16 +201,16 @@ impl<'a> Lookahead<'a> {
     /// where the span is scattered, skipped where it is a whole run.
     #[inline(always)]
     pub fn step(&mut self, span: Span, mut prefetch: impl FnMut(usize)) {
-        let Some(objects) = &mut self.next else {
+        if let Upcoming::None = self.next {
             return;
-        };
+        }
         if span.is_full() {
-            objects.nth(span.count - 1);
+            self.next.nth(span.count - 1);
             return;
         }
         for _ in 0..span.lanes.count_ones() {
-            if let Some(s) = objects.next() {
-                prefetch(s.start);
+            if let Some(i) = self.next.next() {
+                prefetch(i);
             }
         }
     }
@@ -196,8 +218,8 @@ impl<'a> Lookahead<'a> {
     /// Before a scattered object runs alone: one object further.
     #[inline(always)]
     pub fn one(&mut self, prefetch: impl FnOnce(usize)) {
-        if let Some(s) = self.next.as_mut().and_then(Iterator::next) {
-            prefetch(s.start);
+        if let Some(i) = self.next.next() {
+            prefetch(i);
         }
     }
 }

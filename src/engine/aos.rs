@@ -53,6 +53,7 @@ impl AosSink for &mut [Aabb3] {
     fn one(&mut self, i: usize, tight: Aabb3) {
         self[i] = tight;
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self[i]);
     }
@@ -189,10 +190,12 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
         simd::prefetch(poses.at(i));
         sink.prefetch(i);
     };
-    let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
+    // Each walk builds its own lookahead, so that the kind of active set is a constant in
+    // its loop.
     if let Active::Indices(ix) = active {
         // A list in its order: building each span's mask from a list cost more than the
         // objects (1.4x at 1% and 10% active, measured on an Intel Xeon).
+        let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
         for &i in ix {
             let i = i as usize;
             lookahead.one(|i| ahead(&sink, i));
@@ -200,6 +203,7 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
         }
         return;
     }
+    let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
     for span in Spans::new(active, local.len(), SPAN) {
         lookahead.step(span, |i| ahead(&sink, i));
         if span.is_full() {

@@ -87,6 +87,7 @@ pub(crate) trait Poses<const N: usize> {
         rounding: Rounding,
     ) -> [[f32; N]; 2];
     /// Asks for object `i`'s poses ahead of a scattered access.
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
@@ -128,6 +129,7 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
         let (min, max) = extended::transform(&self.get(i).extended(), lo, hi, rounding);
         [min, max]
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadMaps::prefetch(self, i);
     }
@@ -154,6 +156,7 @@ pub(crate) trait Sink<const N: usize> {
         redo: impl Fn(usize) -> [[f32; N]; 2],
     );
     /// Asks for object `i`'s output ahead of a scattered access.
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
@@ -187,9 +190,14 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         } else {
             self.out.store(i, count, min, max);
         }
-        // The rare lanes that do not stand are recomputed from the source data; nothing
-        // here takes `&mut self` out of line, so the layout descriptors stay in registers.
+        // The rare lanes that do not stand are recomputed from the source data. The branch
+        // is marked cold, so that the registers go to the common path (an in-cache SoA
+        // rigid batch ran up to 1.15x slower without the hint); and nothing here takes
+        // `&mut self` out of line, so the layout descriptors stay in registers (calling
+        // out of line with them cost an in-cache AoSoA translation batch 1.1-1.35x; both
+        // measured on an Intel Xeon).
         if stands.any_nonzero() {
+            core::hint::cold_path();
             for k in 0..count {
                 if stands.get(k) != 0.0 {
                     let [min, max] = redo(i + k);

@@ -46,6 +46,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         B::aabb3s(self)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
@@ -117,6 +118,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Each(self))
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
@@ -159,6 +161,7 @@ impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         E::aabb3s(self.as_slice())
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
@@ -218,6 +221,7 @@ impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {
         Some(Maps::Each(self.as_slice()))
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }

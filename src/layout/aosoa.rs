@@ -128,7 +128,7 @@ impl<T: Fields> Block8<T> {
     }
 
     /// Asks for the cache lines of value `k` (one per field at most).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn prefetch(&self, k: usize) {
         for field in self.fields.as_ref() {
             crate::simd::prefetch(&field[k]);
@@ -211,6 +211,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
         let (lo, hi) = box_lanes::<f32, N>(&self[i / 8].get(i % 8).to_fields());
         (lo.0, hi.0)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         self[i / 8].prefetch(i % 8);
     }
@@ -317,6 +318,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     fn get(&self, i: usize) -> T {
         self[i / 8].get(i % 8)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         self[i / 8].prefetch(i % 8);
     }
@@ -333,6 +335,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.as_slice(), i)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadBoxes::prefetch(&self.as_slice(), i);
     }
@@ -396,6 +399,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
     fn get(&self, i: usize) -> T {
         ReadMaps::get(&self.as_slice(), i)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadMaps::prefetch(&self.as_slice(), i);
     }

@@ -63,6 +63,7 @@ pub(crate) mod sealed {
             None
         }
         /// Asks for box `i`'s cache lines ahead of a scattered access.
+        #[inline(always)]
         fn prefetch(&self, i: usize) {
             let _ = i;
         }
@@ -134,6 +135,7 @@ pub(crate) mod sealed {
             None
         }
         /// Asks for transform `i`'s cache lines ahead of a scattered access.
+        #[inline(always)]
         fn prefetch(&self, i: usize) {
             let _ = i;
         }

@@ -220,6 +220,7 @@ fn split_columns<'p, T: Fields>(
 }
 
 /// Asks for entry `i` of every column.
+#[inline(always)]
 fn prefetch_columns(columns: &[&[f32]], i: usize) {
     for column in columns {
         crate::simd::prefetch(&column[i]);
@@ -270,6 +271,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
             core::array::from_fn(|a| c[N + a][i]),
         )
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
@@ -354,6 +356,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
         }
         T::from_fields(&v)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
@@ -373,6 +376,7 @@ where
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.view(), i)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadBoxes::prefetch(&self.view(), i);
     }
@@ -436,6 +440,7 @@ where
     fn get(&self, i: usize) -> Self::Class {
         ReadMaps::get(&self.view(), i)
     }
+    #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadMaps::prefetch(&self.view(), i);
     }

@@ -106,6 +106,8 @@ pub fn parry_scene(
 }
 
 /// Memory roofline for SoA columns (6 box columns, 12 transform columns, 6 outputs).
+/// Never inlined, like [`roofline_blocks`].
+#[inline(never)]
 pub fn roofline_soa(boxes: &bvkit::AabbSoa, xfs: &bvkit::Affine3Soa, out: &mut bvkit::AabbSoa) {
     for a in 0..3 {
         let c = &xfs.columns;
@@ -121,6 +123,8 @@ pub fn roofline_soa(boxes: &bvkit::AabbSoa, xfs: &bvkit::Affine3Soa, out: &mut b
 }
 
 /// Memory roofline for AoS slices.
+/// Never inlined, like [`roofline_blocks`].
+#[inline(never)]
 pub fn roofline_aos(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
     for ((b, x), o) in boxes.iter().zip(xfs).zip(out) {
         let m = x.matrix3.x_axis + x.matrix3.y_axis + x.matrix3.z_axis + x.translation;
@@ -187,6 +191,11 @@ pub fn glam_rigid_abs_matrix(boxes: &[Aabb3], poses: &[bvkit::Rigid3], out: &mut
 /// Memory roofline for AoSoA blocks of any class with `F` fields: reads every byte of the
 /// boxes and transforms and writes every byte of the output, with one addition per input
 /// float.
+///
+/// Never inlined, like every roofline here: each bench then measures the same code whatever
+/// the bench around it inlines (inlined into one build's bench closure, the in-cache AoSoA
+/// roofline ran 2.7-4x slower).
+#[inline(never)]
 pub fn roofline_blocks<const F: usize>(
     boxes: &[[[f32; 8]; 6]],
     xfs: &[[[f32; 8]; F]],
@@ -210,8 +219,10 @@ pub fn roofline_blocks<const F: usize>(
 /// [`roofline_blocks`] with non-temporal stores: each output block goes to memory through
 /// `_mm_stream_ps`, bypassing the caches, then one `_mm_sfence`. The experiment behind the
 /// question whether bvkit should stream outputs larger than the last-level cache: a kernel
-/// can only gain what this roofline gains over the plain one.
+/// can only gain what this roofline gains over the plain one. Never inlined, like
+/// [`roofline_blocks`].
 #[cfg(target_arch = "x86_64")]
+#[inline(never)]
 pub fn roofline_blocks_streaming<const F: usize>(
     boxes: &[[[f32; 8]; 6]],
     xfs: &[[[f32; 8]; F]],
