@@ -238,8 +238,11 @@ fn gather<L: LaneArray, T: Fields>(
     let columns = columns.as_ref();
     let mut f = zero_fields::<L>();
     if count == L::WIDTH {
+        // `i..end` rather than `i..`: the check `i <= end` is shared by every column, so
+        // each column costs one length check.
+        let end = i + L::WIDTH;
         for n in 0..T::FIELDS {
-            f[n] = L::load(&columns[n][i..]);
+            f[n] = L::load(&columns[n][i..end]);
         }
         return f;
     }
@@ -303,9 +306,10 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
     ) {
         let columns = self.columns.as_mut();
         if count == L::WIDTH {
+            let end = i + L::WIDTH;
             for a in 0..N {
-                min.0[a].store(&mut columns[a][i..]);
-                max.0[a].store(&mut columns[N + a][i..]);
+                min.0[a].store(&mut columns[a][i..end]);
+                max.0[a].store(&mut columns[N + a][i..end]);
             }
             return;
         }
