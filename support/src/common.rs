@@ -282,7 +282,10 @@ pub fn configure(
 }
 
 /// `out[k] = boxes[k].transformed(&xfs[k], method, rounding)` as a user writes it, with
-/// the method and rounding as constants at the call (each arm is its own loop).
+/// the method and rounding as constants at the call (each arm is its own loop). Never
+/// inlined, like [`roofline_blocks`]: inlined into one build's bench closure and not into
+/// another's, the same loop measured up to 5% apart.
+#[inline(never)]
 pub fn single_loop<T: bvkit::Transform3>(
     boxes: &[Aabb3],
     xfs: &[T],
