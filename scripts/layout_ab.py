@@ -120,14 +120,13 @@ def main():
         b = [r[row] for r in runs["before"]]
         f = [r[row] for r in runs["after"]]
         mb, mf = statistics.median(b), statistics.median(f)
-        ratios.append((mf / mb, row))
+        ratios.append(mf / mb)
         print(f"| {row} | {show(mb)} | {show(mf)} | {mf / mb:.3f} | "
               f"{statistics.mean(f) / statistics.mean(b):.3f} | "
               f"{min(b) / mb:.2f}-{max(b) / mb:.2f} | {min(f) / mf:.2f}-{max(f) / mf:.2f} |")
     if ratios:
-        q = [r for r, _ in ratios]
-        print(f"\n{len(q)} rows: median {statistics.median(q):.3f}, min {min(q):.3f}, "
-              f"max {max(q):.3f}")
+        print(f"\n{len(ratios)} rows: median {statistics.median(ratios):.3f}, "
+              f"min {min(ratios):.3f}, max {max(ratios):.3f}")
 
 
 if __name__ == "__main__":
