@@ -25,6 +25,12 @@ struct Window<'a, S> {
     len: usize,
 }
 
+impl<S> Clone for Window<'_, S> {
+    fn clone(&self) -> Self {
+        Self { ..*self }
+    }
+}
+
 impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(self.len)
@@ -39,10 +45,20 @@ impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         self.src.aabb3s()?.get(self.start..self.start + self.len)
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
 impl<const N: usize, S: ReadMaps<N>> ReadMaps<N> for Window<'_, S> {
     type Class = S::Class;
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
     fn len(&self) -> Result<Option<usize>, BatchError> {
         Ok(self.src.len()?.map(|_| self.len))
     }

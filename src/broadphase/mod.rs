@@ -6,7 +6,7 @@ mod moved;
 
 use crate::aabb::Aabb3;
 use crate::batch::Batch;
-use crate::engine::{Active, AosRun, AosSink, Engine, Poses, Sink, Tight};
+use crate::engine::{Active, AosRun, AosSink, Engine, Poses, Redo, Sink, Tight};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::lane::Vector;
@@ -57,6 +57,14 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
         self.current.check_len(len)?;
         self.predicted.check_len(len)
     }
+    type Trimmed = Swept<A::Trimmed, B::Trimmed>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self::Trimmed {
+        Swept {
+            current: self.current.trim(len),
+            predicted: self.predicted.trim(len),
+        }
+    }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         self.current.prefetch(i);
@@ -106,6 +114,14 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
 impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         BatchError::check_len("poses", len, self.poses.len())
+    }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        Self {
+            poses: &self.poses[..len],
+            origin: self.origin,
+        }
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -270,7 +286,7 @@ struct Fat<'a, F> {
     moved: &'a mut Moved,
 }
 
-impl<const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'_, F> {
+impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
     #[inline(always)]
     fn span<L: LaneArray>(
         &mut self,
@@ -279,7 +295,7 @@ impl<const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'_, F> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         stands: L,
-        redo: impl Fn(usize) -> [[f32; N]; 2],
+        redo: &impl Redo<N>,
     ) {
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
         let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
@@ -301,6 +317,15 @@ impl<const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'_, F> {
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
+    type Trimmed = Fat<'a, F::Trimmed>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self::Trimmed {
+        Fat {
+            fat: self.fat.trim(len),
+            margin: self.margin,
+            moved: self.moved,
+        }
+    }
 }
 
 impl<F> Fat<'_, F> {
@@ -318,7 +343,7 @@ impl<F> Fat<'_, F> {
         [outside, stands]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
-        redo: impl Fn(usize) -> [[f32; N]; 2],
+        redo: &impl Redo<N>,
     ) where
         F: WriteBoxes<N>,
     {
@@ -352,7 +377,7 @@ impl<F> Fat<'_, F> {
         let mut bits = redo_lanes;
         while bits != 0 {
             let k = bits.trailing_zeros() as usize;
-            if self.redo(i + k, redo(i + k)) {
+            if self.redo(i + k, redo.tight(i + k)) {
                 moved |= 1 << k;
             }
             bits &= bits - 1;

@@ -97,6 +97,11 @@ pub(crate) trait Poses<const N: usize> {
         let _ = (run, backend);
         false
     }
+    /// The same poses, as the loop reads them.
+    type Trimmed: Poses<N> + Clone;
+    /// The first `len` poses, every slice cut to that length (see
+    /// [`ReadBoxes::trim`](crate::layout::ReadBoxes::trim)).
+    fn trim(self, len: usize) -> Self::Trimmed;
 }
 
 impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
@@ -133,6 +138,11 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     fn prefetch(&self, i: usize) {
         ReadMaps::prefetch(self, i);
     }
+    type Trimmed = X::Trimmed;
+    #[inline(always)]
+    fn trim(self, len: usize) -> X::Trimmed {
+        ReadMaps::trim(self, len)
+    }
     fn run_aos<S: AosSink>(&self, run: AosRun<'_, S>, backend: Backend) -> bool {
         match self.maps() {
             Some(maps) => X::Class::run_simd3(run.with(maps), backend),
@@ -141,11 +151,56 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     }
 }
 
+/// The tight box of one object on the extended path, for a lane that does not stand.
+pub(crate) trait Redo<const N: usize> {
+    /// Object `i`'s tight box `[min, max]`.
+    fn tight(&self, i: usize) -> [[f32; N]; 2];
+}
+
+/// [`Redo`] from the run's sources, which it hands by value to an out-of-line function.
+/// The loop must never take the address of its trimmed sources: their lengths would then
+/// stay in memory and every column's bound be checked on every span (as happened when the
+/// cold path called a closure that borrowed them); and the cold path's addressing must
+/// stay out of the loop (inlined, it made LLVM keep a pointer per column, in stack slots
+/// updated on every span).
+struct Extended<'r, B, P> {
+    local: &'r B,
+    poses: &'r P,
+    method: Method,
+    rounding: Rounding,
+}
+
+impl<const N: usize, B: ReadBoxes<N> + Clone, P: Poses<N> + Clone> Redo<N> for Extended<'_, B, P> {
+    #[inline(always)]
+    fn tight(&self, i: usize) -> [[f32; N]; 2] {
+        tight_one(
+            self.local.clone(),
+            self.poses.clone(),
+            i,
+            self.method,
+            self.rounding,
+        )
+    }
+}
+
+/// Object `i`'s tight box on the extended path, from copies of the sources.
+#[inline(never)]
+fn tight_one<const N: usize, B: ReadBoxes<N>, P: Poses<N>>(
+    local: B,
+    poses: P,
+    i: usize,
+    method: Method,
+    rounding: Rounding,
+) -> [[f32; N]; 2] {
+    let (lo, hi) = local.get(i);
+    poses.tight_one(i, lo, hi, method, rounding)
+}
+
 /// Where the lane loop's tight boxes go.
 pub(crate) trait Sink<const N: usize> {
     /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
     /// `lanes` bits are active. Where `stands` is nonzero the lane's box must be replaced
-    /// by `redo(i + k)`, its box on the extended path.
+    /// by `redo.tight(i + k)`, its box on the extended path.
     fn span<L: LaneArray>(
         &mut self,
         i: usize,
@@ -153,7 +208,7 @@ pub(crate) trait Sink<const N: usize> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         stands: L,
-        redo: impl Fn(usize) -> [[f32; N]; 2],
+        redo: &impl Redo<N>,
     );
     /// Asks for object `i`'s output ahead of a scattered access.
     #[inline(always)]
@@ -162,6 +217,11 @@ pub(crate) trait Sink<const N: usize> {
     }
     /// After the last span (a fence after streaming stores).
     fn finish(&mut self) {}
+    /// The same sink, as the loop writes it.
+    type Trimmed: Sink<N>;
+    /// The sink for the first `len` objects, every slice cut to that length (see
+    /// [`ReadBoxes::trim`](crate::layout::ReadBoxes::trim)).
+    fn trim(self, len: usize) -> Self::Trimmed;
 }
 
 /// The plain sink: every tight box written to `out`, past the caches when `stream` is set.
@@ -181,7 +241,7 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         lanes: u64,
         [min, max]: [Vector<L, N>; 2],
         stands: L,
-        redo: impl Fn(usize) -> [[f32; N]; 2],
+        redo: &impl Redo<N>,
     ) {
         // Every object is active: a store writes whole spans.
         debug_assert_eq!(lanes.count_ones() as usize, count);
@@ -200,7 +260,7 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
             core::hint::cold_path();
             for k in 0..count {
                 if stands.get(k) != 0.0 {
-                    let [min, max] = redo(i + k);
+                    let [min, max] = redo.tight(i + k);
                     self.out.set(i + k, min, max);
                 }
             }
@@ -209,6 +269,14 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
     fn finish(&mut self) {
         if self.stream {
             simd::store_fence();
+        }
+    }
+    type Trimmed = Store<O::Trimmed>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Store<O::Trimmed> {
+        Store {
+            out: self.out.trim(len),
+            stream: self.stream,
         }
     }
 }
@@ -294,7 +362,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, 
     /// every call site, for no measurable speed).
     #[inline(always)]
     fn run<L: LaneArray>(self) {
-        let mut run = self.0;
+        let mut run = self.0.trim();
         let outward = run.rounding == Rounding::Outward;
         specialise!(run.method, |method| run.every::<L>(method, outward));
         run.sink.finish();
@@ -305,7 +373,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Scattered
     /// As for [`Every`].
     #[inline(always)]
     fn run<L: LaneArray>(self) {
-        let (mut run, active) = (self.run, self.active);
+        let (mut run, active) = (self.run.trim(), self.active);
         let outward = run.rounding == Rounding::Outward;
         specialise!(run.method, |method| {
             run.spans::<L>(active, method, outward)
@@ -315,6 +383,29 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Scattered
 }
 
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Run<N, B, P, S> {
+    /// The run with every source and sink trimmed to `len`: called inside the job, so that
+    /// the lengths the slices carry are the loop's own bound, and their checks fold into
+    /// one per span.
+    #[inline(always)]
+    fn trim(self) -> Run<N, B::Trimmed, P::Trimmed, S::Trimmed> {
+        let len = self.len;
+        Run {
+            local: self.local.trim(len),
+            poses: self.poses.trim(len),
+            sink: self.sink.trim(len),
+            len,
+            method: self.method,
+            rounding: self.rounding,
+        }
+    }
+}
+
+impl<const N: usize, B, P, S> Run<N, B, P, S>
+where
+    B: ReadBoxes<N> + Clone,
+    P: Poses<N> + Clone,
+    S: Sink<N>,
+{
     /// Every object: a plain loop over whole spans, then the tail one lane at a time.
     /// Walking [`Spans`] here measured up to 1.5x slower on cheap kernels in cache (the
     /// per-span decoding and mask tests are not free there).
@@ -377,11 +468,12 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Run<N, B, P, S> {
     ) {
         let (lo, hi) = self.local.load::<L>(i, count);
         let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
-        let (local, poses, rounding) = (&self.local, &self.poses, self.rounding);
-        let redo = |j: usize| {
-            let (lo, hi) = local.get(j);
-            poses.tight_one(j, lo, hi, method, rounding)
+        let redo = Extended {
+            local: &self.local,
+            poses: &self.poses,
+            method,
+            rounding: self.rounding,
         };
-        self.sink.span(i, count, lanes, [min, max], stands, redo);
+        self.sink.span(i, count, lanes, [min, max], stands, &redo);
     }
 }

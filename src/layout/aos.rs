@@ -50,6 +50,11 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        &self[..len]
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
@@ -63,6 +68,11 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
     #[inline(always)]
     fn read(&self) -> &[B] {
         self
+    }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        &mut self[..len]
     }
     #[inline(always)]
     fn store<L: LaneArray>(
@@ -122,6 +132,11 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        &self[..len]
+    }
 }
 
 /// One transform shared by every box (compound bodies, instanced props).
@@ -145,9 +160,14 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Shared(self))
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
-impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
+impl<'a, const N: usize, E: Boxes<N>> ReadBoxes<N> for &'a Vec<E> {
     fn len(&self) -> Result<usize, BatchError> {
         ReadBoxes::len(&self.as_slice())
     }
@@ -165,9 +185,14 @@ impl<const N: usize, E: Boxes<N>> ReadBoxes<N> for &Vec<E> {
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
     }
+    type Trimmed = &'a [E];
+    #[inline(always)]
+    fn trim(self, len: usize) -> &'a [E] {
+        &self[..len]
+    }
 }
 
-impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
+impl<'a, const N: usize, E: Boxes<N>> WriteBoxes<N> for &'a mut Vec<E> {
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.as_mut_slice())
     }
@@ -178,6 +203,11 @@ impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
     #[inline(always)]
     fn read(&self) -> &[E] {
         self
+    }
+    type Trimmed = &'a mut [E];
+    #[inline(always)]
+    fn trim(self, len: usize) -> &'a mut [E] {
+        &mut self[..len]
     }
     #[inline(always)]
     fn store<L: LaneArray>(
@@ -206,7 +236,7 @@ impl<const N: usize, E: Boxes<N>> WriteBoxes<N> for &mut Vec<E> {
     }
 }
 
-impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
+impl<'a, const N: usize, E: Class<N>> ReadMaps<N> for &'a Vec<E> {
     type Class = E;
     fn len(&self) -> Result<Option<usize>, BatchError> {
         ReadMaps::len(&self.as_slice())
@@ -224,5 +254,10 @@ impl<const N: usize, E: Class<N>> ReadMaps<N> for &Vec<E> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         crate::simd::prefetch(&self[i]);
+    }
+    type Trimmed = &'a [E];
+    #[inline(always)]
+    fn trim(self, len: usize) -> &'a [E] {
+        &self[..len]
     }
 }

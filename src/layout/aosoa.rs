@@ -1,5 +1,8 @@
 //! AoSoA blocks: eight boxes or eight transforms per 32-byte-aligned block, one `[f32; 8]`
 //! per scalar field, so that a lane block is a handful of aligned vector loads.
+//!
+//! Blocks are not trimmed for the engine: a span's loads index whole blocks (`i / 8`),
+//! which the loop bound on `i` does not cover.
 
 use alloc::vec::Vec;
 use glam::{Affine2, Affine3A};
@@ -215,6 +218,11 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
     fn prefetch(&self, i: usize) {
         self[i / 8].prefetch(i % 8);
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
@@ -304,6 +312,11 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
     fn parts(&mut self, chunk: usize) -> Vec<&mut [Block8<B>]> {
         self.chunks_mut(chunk / 8).collect()
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
@@ -322,6 +335,11 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     fn prefetch(&self, i: usize) {
         self[i / 8].prefetch(i % 8);
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
@@ -338,6 +356,11 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadBoxes::prefetch(&self.as_slice(), i);
+    }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
     }
 }
 
@@ -385,6 +408,11 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
     fn parts(&mut self, chunk: usize) -> Vec<&mut [Block8<B>]> {
         self.chunks_mut(chunk / 8).collect()
     }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
+    }
 }
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
@@ -402,6 +430,11 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         ReadMaps::prefetch(&self.as_slice(), i);
+    }
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, _: usize) -> Self {
+        self
     }
 }
 

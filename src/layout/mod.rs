@@ -67,6 +67,13 @@ pub(crate) mod sealed {
         fn prefetch(&self, i: usize) {
             let _ = i;
         }
+        /// The same boxes, as the engine's loop reads them.
+        type Trimmed: ReadBoxes<N> + Clone;
+        /// The first `len` boxes (`len` at most [`ReadBoxes::len`]), every slice cut to
+        /// that length. The engine trims inside its loop's function, so that every slice
+        /// carries the loop's own bound `len` and the per-column (or per-item) bounds
+        /// checks fold into one per span; a layout with nothing to gain returns itself.
+        fn trim(self, len: usize) -> Self::Trimmed;
     }
 
     /// Boxes to write.
@@ -107,6 +114,10 @@ pub(crate) mod sealed {
             Self: 'r;
         /// The boxes as a source.
         fn read(&self) -> Self::Read<'_>;
+        /// The same boxes, as the engine's loop writes them.
+        type Trimmed: WriteBoxes<N>;
+        /// The first `len` boxes, every slice cut to that length: see [`ReadBoxes::trim`].
+        fn trim(self, len: usize) -> Self::Trimmed;
         /// A part of the sink: the same layout over a run of boxes.
         #[cfg(feature = "rayon")]
         type Part<'p>: WriteBoxes<N> + Send
@@ -139,6 +150,11 @@ pub(crate) mod sealed {
         fn prefetch(&self, i: usize) {
             let _ = i;
         }
+        /// The same transforms, as the engine's loop reads them.
+        type Trimmed: ReadMaps<N, Class = Self::Class> + Clone;
+        /// The first `len` transforms (a shared one stays whole), every slice cut to that
+        /// length: see [`ReadBoxes::trim`].
+        fn trim(self, len: usize) -> Self::Trimmed;
     }
 }
 

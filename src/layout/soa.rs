@@ -178,6 +178,18 @@ impl<'a, T: Fields> SoaRef<'a, T> {
     pub fn new(columns: T::Array<&'a [f32]>) -> Self {
         Self { columns }
     }
+
+    /// Every column cut to its first `len` values (the engine's trim), in place: built anew
+    /// by `array::from_fn`, left out of line for many columns, the lengths came back
+    /// through memory as values the compiler could not tell equal to `len`.
+    #[inline(always)]
+    fn prefix(mut self, len: usize) -> Self {
+        for column in self.columns.as_mut() {
+            let whole: &'a [f32] = column;
+            *column = &whole[..len];
+        }
+        self
+    }
 }
 
 impl<'a, T: Fields> SoaMut<'a, T> {
@@ -185,6 +197,17 @@ impl<'a, T: Fields> SoaMut<'a, T> {
     #[must_use]
     pub fn new(columns: T::Array<&'a mut [f32]>) -> Self {
         Self { columns }
+    }
+
+    /// Every column cut to its first `len` values (the engine's trim), in place, as for
+    /// [`SoaRef`].
+    #[inline(always)]
+    fn prefix(mut self, len: usize) -> Self {
+        for column in self.columns.as_mut() {
+            let whole = core::mem::take(column);
+            *column = &mut whole[..len];
+        }
+        self
     }
 }
 
@@ -257,6 +280,11 @@ fn gather<L: LaneArray, T: Fields>(
 }
 
 impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        self.prefix(len)
+    }
     fn len(&self) -> Result<usize, BatchError> {
         common_len(
             "a column of the local boxes",
@@ -281,6 +309,11 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
 }
 
 impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        self.prefix(len)
+    }
     fn len(&mut self) -> Result<usize, BatchError> {
         common_len(
             "a column of the output",
@@ -322,6 +355,9 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
             }
         }
     }
+    /// Inlined: out of line, it would take the address of the engine's trimmed output,
+    /// whose lengths would then stay in memory and be checked on every span.
+    #[inline(always)]
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         let columns = self.columns.as_mut();
         for a in 0..N {
@@ -342,6 +378,11 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
 
 impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
     type Class = T;
+    type Trimmed = Self;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self {
+        self.prefix(len)
+    }
     fn len(&self) -> Result<Option<usize>, BatchError> {
         common_len(
             "a column of the transforms",
@@ -370,6 +411,11 @@ impl<'a, const N: usize, E: Fields> ReadBoxes<N> for &'a Soa<E>
 where
     SoaRef<'a, E>: ReadBoxes<N>,
 {
+    type Trimmed = SoaRef<'a, E>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> SoaRef<'a, E> {
+        self.view().prefix(len)
+    }
     fn len(&self) -> Result<usize, BatchError> {
         ReadBoxes::len(&self.view())
     }
@@ -386,11 +432,16 @@ where
     }
 }
 
-impl<const N: usize, E: Fields> WriteBoxes<N> for &mut Soa<E>
+impl<'a, const N: usize, E: Fields> WriteBoxes<N> for &'a mut Soa<E>
 where
     for<'b> SoaMut<'b, E>: WriteBoxes<N>,
     for<'b> SoaRef<'b, E>: ReadBoxes<N>,
 {
+    type Trimmed = SoaMut<'a, E>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> SoaMut<'a, E> {
+        self.view_mut().prefix(len)
+    }
     fn len(&mut self) -> Result<usize, BatchError> {
         WriteBoxes::len(&mut self.view_mut())
     }
@@ -434,6 +485,11 @@ where
     SoaRef<'a, E>: ReadMaps<N>,
 {
     type Class = <SoaRef<'a, E> as ReadMaps<N>>::Class;
+    type Trimmed = SoaRef<'a, E>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> SoaRef<'a, E> {
+        self.view().prefix(len)
+    }
     fn len(&self) -> Result<Option<usize>, BatchError> {
         ReadMaps::len(&self.view())
     }
