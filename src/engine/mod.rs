@@ -358,8 +358,10 @@ struct Scattered<'a, const N: usize, B, P, S> {
 
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, B, P, S> {
     /// One loop per method, so that each is specialised to its kernel; the rounding is a
-    /// loop-invariant branch (specialising it too doubled the code, and the build time of
-    /// every call site, for no measurable speed).
+    /// loop-invariant branch. Specialising it too grew the `speed` bench binary by 15%;
+    /// it sped most in-cache SoA rows by up to 24% but made one rigid row 3.3x slower,
+    /// where LLVM built the quaternion lanes' arithmetic from 128-bit pieces through the
+    /// stack (measured on an Intel Xeon; the issue 23 notes have the tables).
     #[inline(always)]
     fn run<L: LaneArray>(self) {
         let mut run = self.0.trim();
