@@ -287,3 +287,189 @@ impl LaneArray for wide::f32x8 {
         self.simd_ne(wide::f32x8::ZERO).to_bitmask()
     }
 }
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::Avx8;
+
+/// The AVX2 backend's lanes as explicit 256-bit vectors.
+///
+/// [`F32s`] leaves the vectors to LLVM's SLP vectoriser, which sometimes groups a
+/// kernel's scalarised lanes along the wrong dimension (a quaternion's nine matrix entries
+/// built in 128-bit and scalar pieces through the stack, then reloaded as one 256-bit
+/// vector: a store-forwarding stall). With `__m256` every operation is one instruction on
+/// one register from the start, whatever else the loop holds.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)] // the AVX intrinsics, under the invariant of `Avx8`
+mod avx {
+    use core::arch::x86_64::{
+        __m256, _CMP_GE_OQ, _CMP_NEQ_UQ, _mm_stream_ps, _mm256_add_ps, _mm256_andnot_ps,
+        _mm256_blendv_ps, _mm256_castps256_ps128, _mm256_cmp_ps, _mm256_extractf128_ps,
+        _mm256_fmadd_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        _mm256_xor_ps,
+    };
+    use core::ops::{Add, Mul, Neg, Sub};
+
+    use super::{F32s, LaneArray};
+    use crate::lane::Lane;
+
+    /// Eight `f32` lanes in one AVX register; `mul_add` fuses iff `FMA`. Bit for bit the
+    /// arithmetic of `F32s<8, FMA>`: `vminps`/`vmaxps` are the compare-selects of
+    /// [`Lane::min`]/[`Lane::max`], and nothing else is reordered or contracted.
+    ///
+    /// Invariant, on which every intrinsic below relies: a value of this type exists only
+    /// in code compiled with AVX2 and FMA, on a CPU that has them. The type is private to
+    /// the crate and only `dispatch` names it, as the lanes of the `run_avx2` wrapper that
+    /// it calls once `Backend::Avx2` is known to be supported.
+    #[derive(Clone, Copy, Debug)]
+    #[repr(transparent)]
+    pub(crate) struct Avx8<const FMA: bool>(__m256);
+
+    impl<const FMA: bool> Avx8<FMA> {
+        #[inline(always)]
+        fn to_array(self) -> [f32; 8] {
+            // SAFETY: `__m256` and `[f32; 8]` have the same size and every bit pattern is
+            // valid for both.
+            unsafe { core::mem::transmute::<__m256, [f32; 8]>(self.0) }
+        }
+        #[inline(always)]
+        fn from_array(a: [f32; 8]) -> Self {
+            // SAFETY: as in `to_array`.
+            Avx8(unsafe { core::mem::transmute::<[f32; 8], __m256>(a) })
+        }
+    }
+
+    /// One AVX operation on the lanes: the body is an intrinsic call, sound by the
+    /// invariant of [`Avx8`] (the enclosing code is compiled for AVX2 and FMA and runs on
+    /// a CPU with them).
+    macro_rules! avx {
+        ($e:expr) => {
+            // SAFETY: by the invariant of `Avx8`, this runs where AVX2 and FMA are
+            // enabled and present; the intrinsic touches no memory.
+            unsafe { $e }
+        };
+    }
+
+    impl<const FMA: bool> Add for Avx8<FMA> {
+        type Output = Self;
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            Avx8(avx!(_mm256_add_ps(self.0, o.0)))
+        }
+    }
+
+    impl<const FMA: bool> Sub for Avx8<FMA> {
+        type Output = Self;
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            Avx8(avx!(_mm256_sub_ps(self.0, o.0)))
+        }
+    }
+
+    impl<const FMA: bool> Mul for Avx8<FMA> {
+        type Output = Self;
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            Avx8(avx!(_mm256_mul_ps(self.0, o.0)))
+        }
+    }
+
+    impl<const FMA: bool> Neg for Avx8<FMA> {
+        type Output = Self;
+        #[inline(always)]
+        fn neg(self) -> Self {
+            Avx8(avx!(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0))))
+        }
+    }
+
+    impl<const FMA: bool> Lane for Avx8<FMA> {
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            Avx8(avx!(_mm256_set1_ps(x)))
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            // `vminps a, b` is `a < b ? a : b`, lane by lane.
+            Avx8(avx!(_mm256_min_ps(self.0, o.0)))
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            Avx8(avx!(_mm256_max_ps(self.0, o.0)))
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            Avx8(avx!(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)))
+        }
+        #[inline(always)]
+        fn mul_add(self, b: Self, c: Self) -> Self {
+            if FMA {
+                Avx8(avx!(_mm256_fmadd_ps(self.0, b.0, c.0)))
+            } else {
+                self * b + c
+            }
+        }
+        #[inline(always)]
+        fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
+            // `self >= 0`, false for NaN (ordered, quiet).
+            let nonneg = avx!(_mm256_cmp_ps::<_CMP_GE_OQ>(self.0, _mm256_setzero_ps()));
+            Avx8(avx!(_mm256_blendv_ps(otherwise.0, if_nonneg.0, nonneg)))
+        }
+    }
+
+    impl<const FMA: bool> LaneArray for Avx8<FMA> {
+        const WIDTH: usize = 8;
+        type One = F32s<1, FMA>;
+        #[inline(always)]
+        fn get(&self, k: usize) -> f32 {
+            self.to_array()[k]
+        }
+        #[inline(always)]
+        fn set(&mut self, k: usize, x: f32) {
+            let mut a = self.to_array();
+            a[k] = x;
+            *self = Self::from_array(a);
+        }
+        #[inline(always)]
+        fn load(src: &[f32]) -> Self {
+            let src = &src[..8];
+            // SAFETY: `src` holds eight floats (checked above); the load is unaligned, and
+            // AVX is present by the invariant of `Avx8`.
+            Avx8(unsafe { _mm256_loadu_ps(src.as_ptr()) })
+        }
+        #[inline(always)]
+        fn store(self, dst: &mut [f32]) {
+            let dst = &mut dst[..8];
+            // SAFETY: `dst` holds eight exclusively borrowed floats (checked above); the
+            // store is unaligned, and AVX is present by the invariant of `Avx8`.
+            unsafe { _mm256_storeu_ps(dst.as_mut_ptr(), self.0) }
+        }
+        #[inline(always)]
+        fn store_streaming(self, dst: &mut [f32]) {
+            let dst = &mut dst[..8];
+            if dst.as_ptr().align_offset(16) != 0 {
+                return self.store(dst);
+            }
+            let (low, high) = avx!((
+                _mm256_castps256_ps128(self.0),
+                _mm256_extractf128_ps::<1>(self.0)
+            ));
+            // SAFETY: `dst` holds eight exclusively borrowed floats and is 16-byte aligned
+            // (both checked above), so `dst[0..4]` and `dst[4..8]` are aligned, in-bounds
+            // targets; SSE is part of the x86-64 baseline.
+            unsafe {
+                _mm_stream_ps(dst.as_mut_ptr(), low);
+                _mm_stream_ps(dst.as_mut_ptr().add(4), high);
+            }
+        }
+        #[inline(always)]
+        fn any_nonzero(self) -> bool {
+            self.nonzero_mask() != 0
+        }
+        #[inline(always)]
+        fn nonzero_mask(self) -> u32 {
+            // `self != 0`, true for NaN (unordered, quiet).
+            let nonzero = avx!(_mm256_cmp_ps::<_CMP_NEQ_UQ>(self.0, _mm256_setzero_ps()));
+            avx!(_mm256_movemask_ps(nonzero)) as u32
+        }
+    }
+}

@@ -12,6 +12,8 @@ mod lanes;
 
 use alloc::vec::Vec;
 
+#[cfg(target_arch = "x86_64")]
+use lanes::Avx8;
 pub(crate) use lanes::{F32s, LaneArray};
 
 /// A code path for the batch kernels.
@@ -163,10 +165,10 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has every
         // feature of `Backend::Avx2.features()`, the set `run_avx2` enables.
-        (Backend::Avx2, true) => unsafe { run_avx2::<J, F32s<8, true>>(job) },
+        (Backend::Avx2, true) => unsafe { run_avx2::<J, Avx8<true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        (Backend::Avx2, false) => unsafe { run_avx2::<J, F32s<8, false>>(job) },
+        (Backend::Avx2, false) => unsafe { run_avx2::<J, Avx8<false>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has every
         // feature of `Backend::Avx512.features()`, the set `run_avx512` enables.
