@@ -307,9 +307,9 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
             i,
             count,
             lanes,
-            [outside, stands],
-            tight,
-            [fat_min, fat_max],
+            [outside.portable(), stands.portable()],
+            tight.map(L::portable_vector),
+            [fat_min, fat_max].map(L::portable_vector),
             redo,
         );
     }
@@ -332,7 +332,9 @@ impl<F> Fat<'_, F> {
     /// The rest of a span where a box left its fat box or did not stand: the fat boxes
     /// rewritten and the objects recorded. Out of line: inlined, its code (though rarely
     /// run) made LLVM spill the hot path, which then ran three times slower. It uses no
-    /// multiply-add, so it needs none of the dispatcher's target features.
+    /// multiply-add, so it needs none of the dispatcher's target features, and it takes
+    /// the portable lanes ([`LaneArray::Portable`]), which code compiled without them can
+    /// hold.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
     fn rewrite<L: LaneArray, const N: usize>(

@@ -1,13 +1,15 @@
-//! Lane arrays: the lane types of the batch path.
+//! The lane types of the batch path.
 //!
 //! [`F32s`] is plain array code: every operation is a loop over `W` floats that LLVM
 //! vectorises for whatever target features the enclosing function enables, which is what
-//! lets one generic kernel be compiled for SSE2, AVX2+FMA and AVX-512 and be chosen at
-//! run time. `wide::f32x8` is the alternative whose code is fixed at compile time.
+//! lets one generic kernel be compiled for SSE2 and AVX-512 and be chosen at run time.
+//! [`Avx8`], the AVX2 backend's lanes, holds one `__m256` instead, so that its code does
+//! not depend on the vectoriser. `wide::f32x8` is the alternative whose code is fixed at
+//! compile time.
 
 use core::ops::{Add, Mul, Neg, Sub};
 
-use crate::lane::Lane;
+use crate::lane::{Lane, Vector};
 
 /// A lane type whose lanes can be built, read and written one at a time.
 pub trait LaneArray: Lane {
@@ -35,6 +37,22 @@ pub trait LaneArray: Lane {
     fn any_nonzero(self) -> bool;
     /// Bit `k` set where lane `k` is not zero (NaN included).
     fn nonzero_mask(self) -> u32;
+    /// The same lanes, with the same arithmetic, as a type that any code may hold: the
+    /// lanes handed to a function that runs out of line, compiled without the dispatch
+    /// wrapper's target features, where an explicit vector type's operations would each
+    /// become a call.
+    type Portable: LaneArray;
+    /// The lanes as [`LaneArray::Portable`].
+    fn portable(self) -> Self::Portable;
+    /// Each component of `v` as [`LaneArray::Portable`].
+    #[inline(always)]
+    fn portable_vector<const N: usize>(v: Vector<Self, N>) -> Vector<Self::Portable, N> {
+        let mut p = Vector([<Self::Portable as Lane>::splat(0.0); N]);
+        for a in 0..N {
+            p.0[a] = v.0[a].portable();
+        }
+        p
+    }
 }
 
 impl LaneArray for f32 {
@@ -63,6 +81,11 @@ impl LaneArray for f32 {
     #[inline(always)]
     fn nonzero_mask(self) -> u32 {
         u32::from(self != 0.0)
+    }
+    type Portable = f32;
+    #[inline(always)]
+    fn portable(self) -> f32 {
+        self
     }
 }
 
@@ -227,6 +250,11 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
         }
         mask
     }
+    type Portable = Self;
+    #[inline(always)]
+    fn portable(self) -> Self {
+        self
+    }
 }
 
 impl Lane for wide::f32x8 {
@@ -285,6 +313,12 @@ impl LaneArray for wide::f32x8 {
     #[inline(always)]
     fn nonzero_mask(self) -> u32 {
         self.simd_ne(wide::f32x8::ZERO).to_bitmask()
+    }
+    // Its instructions are fixed at compile time: any code may hold it.
+    type Portable = Self;
+    #[inline(always)]
+    fn portable(self) -> Self {
+        self
     }
 }
 
@@ -470,6 +504,11 @@ mod avx {
             // `self != 0`, true for NaN (unordered, quiet).
             let nonzero = avx!(_mm256_cmp_ps::<_CMP_NEQ_UQ>(self.0, _mm256_setzero_ps()));
             avx!(_mm256_movemask_ps(nonzero)) as u32
+        }
+        type Portable = F32s<8, FMA>;
+        #[inline(always)]
+        fn portable(self) -> F32s<8, FMA> {
+            F32s(self.to_array())
         }
     }
 }

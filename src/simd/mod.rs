@@ -2,7 +2,7 @@
 //!
 //! A batch job is written once, generic over a lane type ([`Job::run`]). Dispatch picks the
 //! lane type for the chosen [`Backend`] and, for AVX2+FMA and AVX-512, instantiates the job
-//! inside a `#[target_feature]` wrapper so that the plain array code is compiled for those
+//! inside a `#[target_feature]` wrapper so that the lane code is compiled for those
 //! instructions, although the crate itself is built for the baseline target. The best
 //! backend of the running CPU is detected once and cached. Without the `std` feature there
 //! is no run-time detection: a backend is supported when the build's target features
@@ -25,7 +25,8 @@ pub enum Backend {
     /// Portable lane arrays of 8, compiled for the build's baseline (SSE2 on x86-64, NEON
     /// on aarch64).
     Baseline,
-    /// Lane arrays of 8 compiled for AVX2 with FMA, chosen at run time (x86-64).
+    /// 8 lanes in one 256-bit AVX register, compiled for AVX2 with FMA, chosen at run time
+    /// (x86-64).
     Avx2,
     /// Lane arrays of 16 compiled for AVX-512F, AVX2 and FMA, chosen at run time (x86-64).
     Avx512,
