@@ -352,9 +352,12 @@ mod avx {
     /// [`Lane::min`]/[`Lane::max`], and nothing else is reordered or contracted.
     ///
     /// Invariant, on which every intrinsic below relies: a value of this type exists only
-    /// in code compiled with AVX2 and FMA, on a CPU that has them. The type is private to
-    /// the crate and only `dispatch` names it, as the lanes of the `run_avx2` wrapper that
-    /// it calls once `Backend::Avx2` is known to be supported.
+    /// on a CPU that has AVX2 and FMA. The type is private to the crate and only
+    /// `dispatch` names it, as the lanes of the `run_avx2` wrapper that it calls once
+    /// `Backend::Avx2` is known to be supported. Inlined there, each operation is one
+    /// instruction; code that runs out of line (the debug build's `lanes`) is compiled
+    /// without the features and calls the intrinsics instead, which is slow but sound on
+    /// such a CPU. Out-of-line code on a hot path takes [`LaneArray::Portable`] lanes.
     #[derive(Clone, Copy, Debug)]
     #[repr(transparent)]
     pub(crate) struct Avx8<const FMA: bool>(__m256);
@@ -374,12 +377,11 @@ mod avx {
     }
 
     /// One AVX operation on the lanes: the body is an intrinsic call, sound by the
-    /// invariant of [`Avx8`] (the enclosing code is compiled for AVX2 and FMA and runs on
-    /// a CPU with them).
+    /// invariant of [`Avx8`] (the CPU has AVX2 and FMA).
     macro_rules! avx {
         ($e:expr) => {
-            // SAFETY: by the invariant of `Avx8`, this runs where AVX2 and FMA are
-            // enabled and present; the intrinsic touches no memory.
+            // SAFETY: by the invariant of `Avx8`, the CPU has AVX2 and FMA; the
+            // intrinsic touches no memory.
             unsafe { $e }
         };
     }
