@@ -6,7 +6,9 @@
 //! Two cases per fraction: `stay` (no object leaves its fat box: the update reads the
 //! local box, the pose and the fat box, 96 bytes per active object, and writes nothing)
 //! and `moved` (every active object leaves it, alternating between two poses: 32 more
-//! bytes written, and its index). Active subsets are sorted random index lists.
+//! bytes written, and its index). Active subsets are sorted random index lists, and the
+//! same subsets again as bit masks (`update-mask` and `update-aosoa-mask`, `stay` only: at
+//! 100% a mask of every bit, the path of a scene whose islands all wake).
 //!
 //! The `pipeline` groups run the broadphase example's two pipelines on parry3d's `Bvh`
 //! (`support/src/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
@@ -182,6 +184,41 @@ fn bench(c: &mut Criterion) {
                     .update(margin, active, l, p, &mut fat8[..], &mut moved)
                     .unwrap();
                 assert_eq!(moved.len(), count);
+            })
+        });
+        // The same subset as a mask: the same objects, decoded from bits.
+        let mut mask = vec![0u64; N.div_ceil(64)];
+        match subset {
+            Some(ix) => ix
+                .iter()
+                .for_each(|&i| mask[i as usize / 64] |= 1 << (i % 64)),
+            None => mask.fill(u64::MAX),
+        }
+        let by_mask = Active::Mask(&mask);
+        // The `moved` rows left some fat boxes at the jumped poses: back to `poses`.
+        batch
+            .update(margin, Active::All, local, poses, &mut fat, &mut moved)
+            .unwrap();
+        let (l, p) = (&local8[..], &poses8[..]);
+        batch
+            .update(margin, Active::All, l, p, &mut fat8[..], &mut moved)
+            .unwrap();
+        g.bench_function("update-mask/stay", |b| {
+            b.iter(|| {
+                let l = black_box(local);
+                batch
+                    .update(margin, by_mask, l, poses, &mut fat, &mut moved)
+                    .unwrap();
+                assert!(moved.is_empty());
+            })
+        });
+        g.bench_function("update-aosoa-mask/stay", |b| {
+            b.iter(|| {
+                let (l, p) = (black_box(&local8[..]), &poses8[..]);
+                batch
+                    .update(margin, by_mask, l, p, &mut fat8[..], &mut moved)
+                    .unwrap();
+                assert!(moved.is_empty());
             })
         });
         if percent == 100 {

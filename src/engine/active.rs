@@ -154,13 +154,14 @@ impl Iterator for Spans<'_> {
 const AHEAD: usize = 16;
 
 /// The scattered objects a run will visit next, whose memory it requests [`AHEAD`]
-/// objects in advance. Runs of whole spans are left to the hardware prefetcher, and so is
-/// every object of [`Active::All`].
+/// objects in advance, one object further as each one runs (a burst of requests stalls
+/// the loop once the line fill buffers are full). Runs of whole spans are left to the
+/// hardware prefetcher, and so is every object of [`Active::All`].
 pub(crate) struct Lookahead<'a> {
     next: Upcoming<'a>,
 }
 
-/// The active objects one at a time, in order.
+/// The active objects not yet requested, in order.
 enum Upcoming<'a> {
     /// [`Active::All`]: none are requested.
     None,
@@ -168,58 +169,147 @@ enum Upcoming<'a> {
     /// a time is the hot loop of a sparse update (decoded as spans of one object, it put a
     /// division by the span width in that loop).
     List(core::slice::Iter<'a, u32>),
-    /// A mask's objects: its spans of one object.
-    Mask(Spans<'a>),
+    /// A mask's set bits.
+    Mask(MaskAhead<'a>),
 }
 
-impl Iterator for Upcoming<'_> {
-    type Item = usize;
+/// A mask's set bits from a position on, and how many of those requested lie past the
+/// object running. Whole spans cost nothing: the position stays where it is, and the
+/// first scattered span after them moves it past itself in one step. (Walked bit by bit
+/// across whole spans, as spans of one object, the lookahead cost a dense masked update
+/// more than its arithmetic.)
+struct MaskAhead<'a> {
+    words: &'a [u64],
+    /// The word of `bits`.
+    word: usize,
+    /// The set bits of that word not yet requested.
+    bits: u64,
+    /// The objects requested past the object running: an estimate after whole spans
+    /// (they need not have lain in them), which may then fall short of [`AHEAD`] for a
+    /// while.
+    pending: usize,
+}
+
+impl MaskAhead<'_> {
+    /// The first object not yet requested, or a position at or before it.
+    #[inline(always)]
+    fn position(&self) -> usize {
+        64 * self.word
+            + match self.bits {
+                0 => 64,
+                bits => bits.trailing_zeros() as usize,
+            }
+    }
+
+    /// The next set bit's object.
     #[inline(always)]
     fn next(&mut self) -> Option<usize> {
-        match self {
-            Upcoming::None => None,
-            Upcoming::List(ix) => ix.next().map(|&i| i as usize),
-            Upcoming::Mask(spans) => spans.next().map(|s| s.start),
+        while self.bits == 0 {
+            self.bits = *self.words.get(self.word + 1)?;
+            self.word += 1;
+        }
+        let i = 64 * self.word + self.bits.trailing_zeros() as usize;
+        self.bits &= self.bits - 1;
+        Some(i)
+    }
+
+    /// Requests objects until [`AHEAD`] are pending or the mask ends.
+    #[inline(always)]
+    fn fill(&mut self, mut prefetch: impl FnMut(usize)) {
+        while self.pending < AHEAD {
+            let Some(i) = self.next() else { return };
+            prefetch(i);
+            self.pending += 1;
+        }
+    }
+
+    /// Before `span` runs: past it if it is whole; if it is scattered and the position
+    /// lags behind it, after whole spans, on to its end, nothing then pending (its own
+    /// objects follow a run, which the hardware prefetcher was following).
+    #[inline(always)]
+    fn enter(&mut self, span: Span) {
+        if span.is_full() {
+            self.pending = self.pending.saturating_sub(span.count);
+            return;
+        }
+        if self.position() < span.start {
+            let end = span.start + span.count;
+            let word = end / 64;
+            if word > self.word {
+                self.word = word;
+                self.bits = self.words.get(word).copied().unwrap_or(0);
+            }
+            self.bits &= u64::MAX << (end % 64);
+            self.pending = 0;
         }
     }
 }
 
 impl<'a> Lookahead<'a> {
-    /// The lookahead of `active` over `len` objects, the first objects requested.
+    /// The lookahead of `active`, the first objects requested.
     #[inline(always)]
-    pub fn new(active: Active<'a>, len: usize, mut prefetch: impl FnMut(usize)) -> Self {
-        let mut next = match active {
+    pub fn new(active: Active<'a>, mut prefetch: impl FnMut(usize)) -> Self {
+        let next = match active {
             Active::All => Upcoming::None,
-            Active::Indices(ix) => Upcoming::List(ix.iter()),
-            Active::Mask(_) => Upcoming::Mask(Spans::new(active, len, 1)),
+            Active::Indices(ix) => {
+                let mut ix = ix.iter();
+                ix.by_ref().take(AHEAD).for_each(|&i| prefetch(i as usize));
+                Upcoming::List(ix)
+            }
+            Active::Mask(words) => {
+                let bits = words.first().copied().unwrap_or(0);
+                let mut mask = MaskAhead {
+                    words,
+                    word: 0,
+                    bits,
+                    pending: 0,
+                };
+                mask.fill(prefetch);
+                Upcoming::Mask(mask)
+            }
         };
-        next.by_ref().take(AHEAD).for_each(&mut prefetch);
         Self { next }
     }
 
-    /// Before `span` runs: one object further for each of its active objects, requested
-    /// where the span is scattered, skipped where it is a whole run.
+    /// Before `span` runs, its objects then run one at a time, each after [`Self::one`]:
+    /// a whole span is skipped.
     #[inline(always)]
-    pub fn step(&mut self, span: Span, mut prefetch: impl FnMut(usize)) {
-        if let Upcoming::None = self.next {
-            return;
+    pub fn enter(&mut self, span: Span) {
+        match &mut self.next {
+            Upcoming::List(ix) if span.is_full() => {
+                ix.nth(span.count - 1);
+            }
+            Upcoming::Mask(mask) => mask.enter(span),
+            _ => {}
         }
-        if span.is_full() {
-            self.next.nth(span.count - 1);
-            return;
-        }
-        for _ in 0..span.lanes.count_ones() {
-            if let Some(i) = self.next.next() {
-                prefetch(i);
+    }
+
+    /// Before a scattered object runs: one object further.
+    #[inline(always)]
+    pub fn one(&mut self, mut prefetch: impl FnMut(usize)) {
+        match &mut self.next {
+            Upcoming::None => {}
+            Upcoming::List(ix) => {
+                if let Some(&i) = ix.next() {
+                    prefetch(i as usize);
+                }
+            }
+            Upcoming::Mask(mask) => {
+                mask.pending = mask.pending.saturating_sub(1);
+                mask.fill(prefetch);
             }
         }
     }
 
-    /// Before a scattered object runs alone: one object further.
+    /// Before `span` runs as a whole: [`Self::enter`], and one object further for each
+    /// of its active objects where it is scattered.
     #[inline(always)]
-    pub fn one(&mut self, prefetch: impl FnOnce(usize)) {
-        if let Some(i) = self.next.next() {
-            prefetch(i);
+    pub fn step(&mut self, span: Span, mut prefetch: impl FnMut(usize)) {
+        self.enter(span);
+        if !span.is_full() {
+            for _ in 0..span.lanes.count_ones() {
+                self.one(&mut prefetch);
+            }
         }
     }
 }
@@ -265,6 +355,66 @@ mod tests {
             assert_eq!(objects(Active::Indices(&indices), len, width), expected);
             assert_eq!(objects(Active::Mask(&words), len, width), expected);
             assert!(objects(Active::Indices(&[]), len, width).is_empty());
+        }
+    }
+
+    /// The lookahead requests active objects only, each once, in order, and each object of
+    /// a scattered span before it runs (the first [`AHEAD`] of a span run whole), except
+    /// just after whole spans.
+    #[test]
+    fn the_lookahead_requests_each_scattered_object_before_it_runs() {
+        let len: usize = 1000;
+        // Scattered stretches, whole runs of 64 and 8, and a scattered tail.
+        let active = |i: usize| match i {
+            0..300 => i % 7 == 2 || i.is_multiple_of(13),
+            300..400 => true,
+            400..411 => i.is_multiple_of(3),
+            411..700 => i % 8 == 5 || (512..520).contains(&i),
+            _ => i % 11 == 1,
+        };
+        let indices: Vec<u32> = (0..len as u32).filter(|&i| active(i as usize)).collect();
+        let mut words = alloc::vec![0u64; len.div_ceil(64)];
+        for &i in &indices {
+            words[i as usize / 64] |= 1 << (i % 64);
+        }
+        for set in [Active::Indices(&indices), Active::Mask(&words)] {
+            // Spans run whole (the lane loop), and scattered objects one at a time.
+            for (width, whole) in [(4, true), (8, true), (64, true), (8, false), (64, false)] {
+                let mut requested = Vec::new();
+                let mut ahead = Lookahead::new(set, |i| requested.push(i));
+                // After whole spans, the objects of the next scattered span and the next
+                // `AHEAD` objects may run unrequested.
+                let (mut excused, mut after_whole) = (0, false);
+                for span in Spans::new(set, len, width) {
+                    if whole {
+                        ahead.step(span, |i| requested.push(i));
+                    } else {
+                        ahead.enter(span);
+                    }
+                    if span.is_full() {
+                        (excused, after_whole) = (AHEAD, true);
+                        continue;
+                    }
+                    let ones = (0..span.count).filter(|k| span.lanes >> k & 1 != 0);
+                    // Whole, a span's objects past the first `AHEAD` may run unrequested.
+                    for k in ones.take(if whole { AHEAD } else { 64 }) {
+                        if !whole {
+                            ahead.one(|i| requested.push(i));
+                        }
+                        let i = span.start + k;
+                        if excused > 0 || after_whole {
+                            excused = excused.saturating_sub(1);
+                        } else {
+                            assert!(requested.contains(&i), "{i} {width} {whole} {set:?}");
+                        }
+                    }
+                    after_whole = false;
+                }
+                assert!(requested.iter().all(|&i| active(i)));
+                assert!(requested.windows(2).all(|w| w[0] < w[1]));
+                // The scattered stretches are long: most of their objects were requested.
+                assert!(requested.len() > indices.len() / 3, "{set:?} {width}");
+            }
         }
     }
 }

@@ -164,9 +164,10 @@ impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
 }
 
 /// Every active object through [`Aabb3::transformed`]: all of them in one run; the objects
-/// of a list one at a time; the spans of a mask, its whole words as runs and the rest one
-/// at a time. Scattered objects have their memory requested ahead. `method` and
-/// `rounding` are constants at each call site.
+/// of a list one at a time; the spans of a mask, its whole words that follow each other
+/// as one run and the rest one at a time. Scattered objects have their memory requested
+/// ahead, one object further as each runs. `method` and `rounding` are constants at each
+/// call site.
 #[inline(always)]
 fn walk<'p, T: Transform3 + 'p, S: AosSink>(
     run: AosRun<'_, S>,
@@ -195,7 +196,7 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
     if let Active::Indices(ix) = active {
         // A list in its order: building each span's mask from a list cost more than the
         // objects (1.4x at 1% and 10% active, measured on an Intel Xeon).
-        let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
+        let mut lookahead = Lookahead::new(active, |i| ahead(&sink, i));
         for &i in ix {
             let i = i as usize;
             lookahead.one(|i| ahead(&sink, i));
@@ -203,17 +204,28 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
         }
         return;
     }
-    let mut lookahead = Lookahead::new(active, local.len(), |i| ahead(&sink, i));
-    for span in Spans::new(active, local.len(), SPAN) {
-        lookahead.step(span, |i| ahead(&sink, i));
+    let mut lookahead = Lookahead::new(active, |i| ahead(&sink, i));
+    let mut spans = Spans::new(active, local.len(), SPAN).peekable();
+    while let Some(span) = spans.next() {
+        lookahead.enter(span);
         if span.is_full() {
-            let boxes = &local[span.start..span.start + span.count];
-            sink.run(span.start, boxes, poses.from(span.start), tight);
+            let mut end = span.start + span.count;
+            while let Some(next) = spans.next_if(|s| s.start == end && s.is_full()) {
+                lookahead.enter(next);
+                end += next.count;
+            }
+            sink.run(
+                span.start,
+                &local[span.start..end],
+                poses.from(span.start),
+                tight,
+            );
             continue;
         }
         let mut bits = span.lanes;
         while bits != 0 {
             let i = span.start + bits.trailing_zeros() as usize;
+            lookahead.one(|i| ahead(&sink, i));
             sink.one(i, tight.of(&local[i], poses.at(i)));
             bits &= bits - 1;
         }

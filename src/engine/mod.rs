@@ -429,7 +429,7 @@ where
     /// active object and the tail run in one lane of the same arithmetic.
     #[inline(always)]
     fn spans<L: LaneArray>(&mut self, active: Active<'_>, method: Method, outward: bool) {
-        let mut ahead = Lookahead::new(active, self.len, |i| self.prefetch(i));
+        let mut ahead = Lookahead::new(active, |i| self.prefetch(i));
         for span in Spans::new(active, self.len, L::WIDTH) {
             ahead.step(span, |i| self.prefetch(i));
             if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
