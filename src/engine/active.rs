@@ -2,6 +2,8 @@
 //! into aligned spans of objects.
 
 use crate::error::BatchError;
+use crate::simd::LaneArray;
+use core::marker::PhantomData;
 
 /// The objects an update visits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,32 +73,57 @@ fn low_bits(count: usize) -> u64 {
     u64::MAX >> (64 - count)
 }
 
-/// The active set's spans of `width` objects (1 to 64), ascending: the one decoder of
-/// [`Active`]. Spans with no active object are skipped, a whole empty mask word at a time.
-pub(crate) struct Spans<'a> {
-    active: Active<'a>,
-    len: usize,
-    width: usize,
-    /// The next span's start, or the next position in an index list.
-    at: usize,
+/// The width of a walk's spans, as a constant of a type: a lane type's width, or
+/// [`Width`]. (A run-time width was not always propagated into the mask walk, which then
+/// divided by it.)
+pub(crate) trait SpanWidth {
+    /// The objects of a span: a power of two up to 64.
+    const OBJECTS: usize;
 }
 
-impl<'a> Spans<'a> {
+impl<L: LaneArray> SpanWidth for L {
+    const OBJECTS: usize = L::WIDTH;
+}
+
+/// Spans of `N` objects.
+pub(crate) struct Width<const N: usize>;
+
+impl<const N: usize> SpanWidth for Width<N> {
+    const OBJECTS: usize = N;
+}
+
+/// The active set's spans of `W::OBJECTS` objects, ascending: the one decoder of
+/// [`Active`]. Spans with no active object are skipped, a whole empty mask word at a time.
+pub(crate) struct Spans<'a, W> {
+    active: Active<'a>,
+    len: usize,
+    /// The next span's start, or the next position in an index list.
+    at: usize,
+    width: PhantomData<W>,
+}
+
+impl<'a, W: SpanWidth> Spans<'a, W> {
+    /// Spans of `W::OBJECTS` objects.
+    const W: usize = {
+        assert!(W::OBJECTS.is_power_of_two() && W::OBJECTS <= 64);
+        W::OBJECTS
+    };
+
     /// The spans of `active` over `len` objects (the set checked by [`Active::check`]).
-    pub fn new(active: Active<'a>, len: usize, width: usize) -> Self {
-        debug_assert!((1..=64).contains(&width));
+    #[inline(always)]
+    pub fn new(active: Active<'a>, len: usize) -> Self {
         Self {
             active,
             len,
-            width,
             at: 0,
+            width: PhantomData,
         }
     }
 
     /// The span at `start` with these candidate lanes.
     #[inline(always)]
     fn span(&self, start: usize, lanes: u64) -> Span {
-        let count = self.width.min(self.len - start);
+        let count = Self::W.min(self.len - start);
         Span {
             start,
             count,
@@ -105,7 +132,7 @@ impl<'a> Spans<'a> {
     }
 }
 
-impl Iterator for Spans<'_> {
+impl<W: SpanWidth> Iterator for Spans<'_, W> {
     type Item = Span;
     #[inline(always)]
     fn next(&mut self) -> Option<Span> {
@@ -115,30 +142,29 @@ impl Iterator for Spans<'_> {
                 if start >= self.len {
                     return None;
                 }
-                self.at += self.width;
+                self.at += Self::W;
                 Some(self.span(start, u64::MAX))
             }
             Active::Mask(words) => loop {
-                let start = self.at;
-                if start >= self.len {
-                    return None;
-                }
                 // Straight to the span of the next set bit, a whole empty word at a time.
-                let word = words[start / 64];
+                // Past the last object the word is zero or absent: a checked mask has no
+                // bit past it.
+                let start = self.at;
+                let word = *words.get(start / 64)?;
                 let rest = word >> (start % 64);
                 if rest == 0 {
                     self.at = (start / 64 + 1) * 64;
                     continue;
                 }
                 let next = start + rest.trailing_zeros() as usize;
-                let first = next - next % self.width;
-                self.at = first + self.width;
+                let first = next - next % Self::W;
+                self.at = first + Self::W;
                 return Some(self.span(first, word >> (first % 64)));
             },
             Active::Indices(ix) => {
                 let first = *ix.get(self.at)? as usize;
-                let start = first - first % self.width;
-                let end = start + self.width;
+                let start = first - first % Self::W;
+                let end = start + Self::W;
                 let mut lanes = 0;
                 while let Some(&i) = ix.get(self.at).filter(|&&i| (i as usize) < end) {
                     lanes |= 1 << (i as usize - start);
@@ -157,8 +183,15 @@ const AHEAD: usize = 16;
 /// objects in advance, one object further as each one runs (a burst of requests stalls
 /// the loop once the line fill buffers are full). Runs of whole spans are left to the
 /// hardware prefetcher, and so is every object of [`Active::All`].
+///
+/// The caller requests the objects itself, as [`Self::requests`] yields them, so that its
+/// requests are its own inlined code: handed a closure, the lane loop called it out of
+/// line, a third of a sparse update's time.
 pub(crate) struct Lookahead<'a> {
     next: Upcoming<'a>,
+    /// The requests due: [`AHEAD`] at first, one more for each scattered object that
+    /// starts running.
+    due: usize,
 }
 
 /// The active objects not yet requested, in order.
@@ -173,21 +206,16 @@ enum Upcoming<'a> {
     Mask(MaskAhead<'a>),
 }
 
-/// A mask's set bits from a position on, and how many of those requested lie past the
-/// object running. Whole spans cost nothing: the position stays where it is, and the
-/// first scattered span after them moves it past itself in one step. (Walked bit by bit
-/// across whole spans, as spans of one object, the lookahead took about a third of a
-/// dense masked update's time.)
+/// A mask's set bits from a position on. Whole spans cost nothing: the position stays
+/// where it is, and the first scattered span after them moves it past itself in one step.
+/// (Walked bit by bit across whole spans, as spans of one object, the lookahead took about
+/// a third of a dense masked update's time.)
 struct MaskAhead<'a> {
     words: &'a [u64],
     /// The word of `bits`.
     word: usize,
     /// The set bits of that word not yet requested.
     bits: u64,
-    /// The objects requested past the object running: an estimate after whole spans
-    /// (they need not have lain in them), which may then fall short of [`AHEAD`] for a
-    /// while.
-    pending: usize,
 }
 
 impl MaskAhead<'_> {
@@ -213,104 +241,92 @@ impl MaskAhead<'_> {
         Some(i)
     }
 
-    /// Requests objects until [`AHEAD`] are pending or the mask ends.
+    /// Past `end`, the first object not yet requested.
     #[inline(always)]
-    fn fill(&mut self, mut prefetch: impl FnMut(usize)) {
-        while self.pending < AHEAD {
-            let Some(i) = self.next() else { return };
-            prefetch(i);
-            self.pending += 1;
+    fn seek(&mut self, end: usize) {
+        let word = end / 64;
+        if word > self.word {
+            self.word = word;
+            self.bits = self.words.get(word).copied().unwrap_or(0);
         }
-    }
-
-    /// Before `span` runs: past it if it is whole; if it is scattered and the position
-    /// lags behind it, after whole spans, on to its end, nothing then pending (its own
-    /// objects follow a run, which the hardware prefetcher was following).
-    #[inline(always)]
-    fn enter(&mut self, span: Span) {
-        if span.is_full() {
-            self.pending = self.pending.saturating_sub(span.count);
-            return;
-        }
-        if self.position() < span.start {
-            let end = span.start + span.count;
-            let word = end / 64;
-            if word > self.word {
-                self.word = word;
-                self.bits = self.words.get(word).copied().unwrap_or(0);
-            }
-            self.bits &= u64::MAX << (end % 64);
-            self.pending = 0;
-        }
+        self.bits &= u64::MAX << (end % 64);
     }
 }
 
 impl<'a> Lookahead<'a> {
-    /// The lookahead of `active`, the first objects requested.
+    /// The lookahead of `active`, nothing requested yet.
     #[inline(always)]
-    pub fn new(active: Active<'a>, mut prefetch: impl FnMut(usize)) -> Self {
+    pub fn new(active: Active<'a>) -> Self {
         let next = match active {
             Active::All => Upcoming::None,
-            Active::Indices(ix) => {
-                let mut ix = ix.iter();
-                ix.by_ref().take(AHEAD).for_each(|&i| prefetch(i as usize));
-                Upcoming::List(ix)
-            }
-            Active::Mask(words) => {
-                let bits = words.first().copied().unwrap_or(0);
-                let mut mask = MaskAhead {
-                    words,
-                    word: 0,
-                    bits,
-                    pending: 0,
-                };
-                mask.fill(prefetch);
-                Upcoming::Mask(mask)
-            }
+            Active::Indices(ix) => Upcoming::List(ix.iter()),
+            Active::Mask(words) => Upcoming::Mask(MaskAhead {
+                words,
+                word: 0,
+                bits: words.first().copied().unwrap_or(0),
+            }),
         };
-        Self { next }
+        Self { next, due: AHEAD }
     }
 
-    /// Before `span` runs, its objects then run one at a time, each after [`Self::one`]:
-    /// a whole span is skipped.
+    /// The objects to request now: those due, or fewer where the set ends.
+    #[inline(always)]
+    pub fn requests(&mut self) -> Requests<'_, 'a> {
+        Requests(self)
+    }
+
+    /// Before `span` runs, its objects then run one at a time, each after
+    /// [`Self::advance`]: a whole span is skipped, and a mask's requests that lay in it
+    /// are due again, up to [`AHEAD`] (they need not have lain in it). A scattered span
+    /// after whole spans, where the position lags behind it, moves the position on to its
+    /// end, [`AHEAD`] requests then due (its own objects follow a run, which the hardware
+    /// prefetcher was following).
     #[inline(always)]
     pub fn enter(&mut self, span: Span) {
         match &mut self.next {
-            Upcoming::List(ix) if span.is_full() => {
-                ix.nth(span.count - 1);
-            }
-            Upcoming::Mask(mask) => mask.enter(span),
-            _ => {}
-        }
-    }
-
-    /// Before a scattered object runs: one object further.
-    #[inline(always)]
-    pub fn one(&mut self, mut prefetch: impl FnMut(usize)) {
-        match &mut self.next {
             Upcoming::None => {}
             Upcoming::List(ix) => {
-                if let Some(&i) = ix.next() {
-                    prefetch(i as usize);
+                if span.is_full() {
+                    ix.nth(span.count - 1);
                 }
             }
             Upcoming::Mask(mask) => {
-                mask.pending = mask.pending.saturating_sub(1);
-                mask.fill(prefetch);
+                if span.is_full() {
+                    self.due = AHEAD.min(self.due + span.count);
+                } else if mask.position() < span.start {
+                    mask.seek(span.start + span.count);
+                    self.due = AHEAD;
+                }
             }
         }
     }
 
-    /// Before `span` runs as a whole: [`Self::enter`], and one object further for each
-    /// of its active objects where it is scattered.
+    /// Before `objects` scattered objects run: as many more requests due, so that the next
+    /// [`Self::requests`] goes as many objects further.
     #[inline(always)]
-    pub fn step(&mut self, span: Span, mut prefetch: impl FnMut(usize)) {
-        self.enter(span);
-        if !span.is_full() {
-            for _ in 0..span.lanes.count_ones() {
-                self.one(&mut prefetch);
-            }
+    pub fn advance(&mut self, objects: usize) {
+        self.due += objects;
+    }
+}
+
+/// The objects a [`Lookahead`] requests now, in order.
+pub(crate) struct Requests<'l, 'a>(&'l mut Lookahead<'a>);
+
+impl Iterator for Requests<'_, '_> {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        let ahead = &mut *self.0;
+        if ahead.due == 0 {
+            return None;
         }
+        let i = match &mut ahead.next {
+            Upcoming::None => None,
+            Upcoming::List(ix) => ix.next().map(|&i| i as usize),
+            Upcoming::Mask(mask) => mask.next(),
+        }?;
+        ahead.due -= 1;
+        Some(i)
     }
 }
 
@@ -320,11 +336,11 @@ mod tests {
     use alloc::vec::Vec;
 
     /// The objects of the spans, in order.
-    fn objects(active: Active<'_>, len: usize, width: usize) -> Vec<usize> {
+    fn objects<W: SpanWidth>(active: Active<'_>, len: usize) -> Vec<usize> {
         let mut out = Vec::new();
-        for s in Spans::new(active, len, width) {
-            assert_eq!(s.start % width, 0);
-            assert_eq!(s.count, width.min(len - s.start));
+        for s in Spans::<W>::new(active, len) {
+            assert_eq!(s.start % W::OBJECTS, 0);
+            assert_eq!(s.count, W::OBJECTS.min(len - s.start));
             assert_ne!(s.lanes, 0);
             assert_eq!(s.lanes & !low_bits(s.count), 0);
             out.extend(
@@ -347,15 +363,18 @@ mod tests {
             words[i as usize / 64] |= 1 << (i % 64);
         }
         let expected: Vec<usize> = indices.iter().map(|&i| i as usize).collect();
-        for width in [1, 8, 16, 64] {
-            assert_eq!(
-                objects(Active::All, len, width),
-                (0..len).collect::<Vec<_>>()
-            );
-            assert_eq!(objects(Active::Indices(&indices), len, width), expected);
-            assert_eq!(objects(Active::Mask(&words), len, width), expected);
-            assert!(objects(Active::Indices(&[]), len, width).is_empty());
+        let sets = [Active::All, Active::Indices(&indices), Active::Mask(&words)];
+        let every = (0..len).collect::<Vec<_>>();
+        for (set, expected) in sets.into_iter().zip([&every, &expected, &expected]) {
+            assert_eq!(&objects::<Width<1>>(set, len), expected);
+            assert_eq!(&objects::<Width<8>>(set, len), expected);
+            assert_eq!(&objects::<Width<16>>(set, len), expected);
+            assert_eq!(&objects::<Width<64>>(set, len), expected);
         }
+        assert!(objects::<Width<1>>(Active::Indices(&[]), len).is_empty());
+        assert!(objects::<Width<8>>(Active::Indices(&[]), len).is_empty());
+        assert!(objects::<Width<16>>(Active::Indices(&[]), len).is_empty());
+        assert!(objects::<Width<64>>(Active::Indices(&[]), len).is_empty());
     }
 
     /// The lookahead requests active objects only, each once, in order, and each object of
@@ -379,42 +398,58 @@ mod tests {
         }
         for set in [Active::Indices(&indices), Active::Mask(&words)] {
             // Spans run whole (the lane loop), and scattered objects one at a time.
-            for (width, whole) in [(4, true), (8, true), (64, true), (8, false), (64, false)] {
-                let mut requested = Vec::new();
-                let mut ahead = Lookahead::new(set, |i| requested.push(i));
-                // After whole spans, the objects of the next scattered span and the next
-                // `AHEAD` objects may run unrequested.
-                let (mut excused, mut after_whole) = (0, false);
-                for span in Spans::new(set, len, width) {
-                    if whole {
-                        ahead.step(span, |i| requested.push(i));
-                    } else {
-                        ahead.enter(span);
-                    }
-                    if span.is_full() {
-                        (excused, after_whole) = (AHEAD, true);
-                        continue;
-                    }
-                    let ones = (0..span.count).filter(|k| span.lanes >> k & 1 != 0);
-                    // Whole, a span's objects past the first `AHEAD` may run unrequested.
-                    for k in ones.take(if whole { AHEAD } else { 64 }) {
-                        if !whole {
-                            ahead.one(|i| requested.push(i));
-                        }
-                        let i = span.start + k;
-                        if excused > 0 || after_whole {
-                            excused = excused.saturating_sub(1);
-                        } else {
-                            assert!(requested.contains(&i), "{i} {width} {whole} {set:?}");
-                        }
-                    }
-                    after_whole = false;
-                }
+            let requests = [
+                requests::<Width<4>>(set, len, true),
+                requests::<Width<8>>(set, len, true),
+                requests::<Width<64>>(set, len, true),
+                requests::<Width<8>>(set, len, false),
+                requests::<Width<64>>(set, len, false),
+            ];
+            for requested in requests {
                 assert!(requested.iter().all(|&i| active(i)));
                 assert!(requested.windows(2).all(|w| w[0] < w[1]));
                 // The scattered stretches are long: most of their objects were requested.
-                assert!(requested.len() > indices.len() / 3, "{set:?} {width}");
+                assert!(requested.len() > indices.len() / 3, "{set:?}");
             }
         }
+    }
+
+    /// The objects requested in a walk of `set` in spans of `W`, the spans run whole or
+    /// their objects one at a time, checking that each object of a scattered span was
+    /// requested before it runs, except just after whole spans.
+    fn requests<W: SpanWidth>(set: Active<'_>, len: usize, whole: bool) -> Vec<usize> {
+        let mut requested = Vec::new();
+        let mut ahead = Lookahead::new(set);
+        requested.extend(ahead.requests());
+        // After whole spans, the objects of the next scattered span and the next `AHEAD`
+        // objects may run unrequested.
+        let (mut excused, mut after_whole) = (0, false);
+        for span in Spans::<W>::new(set, len) {
+            ahead.enter(span);
+            if whole && !span.is_full() {
+                ahead.advance(span.lanes.count_ones() as usize);
+                requested.extend(ahead.requests());
+            }
+            if span.is_full() {
+                (excused, after_whole) = (AHEAD, true);
+                continue;
+            }
+            let ones = (0..span.count).filter(|k| span.lanes >> k & 1 != 0);
+            // Whole, a span's objects past the first `AHEAD` may run unrequested.
+            for k in ones.take(if whole { AHEAD } else { 64 }) {
+                if !whole {
+                    ahead.advance(1);
+                    requested.extend(ahead.requests());
+                }
+                let i = span.start + k;
+                if excused > 0 || after_whole {
+                    excused = excused.saturating_sub(1);
+                } else {
+                    assert!(requested.contains(&i), "{i} {} {whole} {set:?}", W::OBJECTS);
+                }
+            }
+            after_whole = false;
+        }
+        requested
     }
 }

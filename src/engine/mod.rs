@@ -429,9 +429,19 @@ where
     /// active object and the tail run in one lane of the same arithmetic.
     #[inline(always)]
     fn spans<L: LaneArray>(&mut self, active: Active<'_>, method: Method, outward: bool) {
-        let mut ahead = Lookahead::new(active, |i| self.prefetch(i));
-        for span in Spans::new(active, self.len, L::WIDTH) {
-            ahead.step(span, |i| self.prefetch(i));
+        let mut ahead = Lookahead::new(active);
+        for i in ahead.requests() {
+            self.prefetch(i);
+        }
+        for span in Spans::<L>::new(active, self.len) {
+            // A scattered span's objects: as many more requested.
+            ahead.enter(span);
+            if !span.is_full() {
+                ahead.advance(span.lanes.count_ones() as usize);
+                for i in ahead.requests() {
+                    self.prefetch(i);
+                }
+            }
             if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
                 self.lanes::<L>(span.start, L::WIDTH, span.lanes, method, outward);
             } else {
