@@ -190,7 +190,8 @@ const AHEAD: usize = 16;
 pub(crate) struct Lookahead<'a> {
     next: Upcoming<'a>,
     /// The requests due: [`AHEAD`] at first, one more for each scattered object that
-    /// starts running.
+    /// starts running ([`Self::advance`]), and set again around whole spans
+    /// ([`Self::enter`]).
     due: usize,
 }
 
