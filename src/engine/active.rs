@@ -82,96 +82,147 @@ pub(crate) trait SpanWidth {
 }
 
 impl<L: LaneArray> SpanWidth for L {
-    const OBJECTS: usize = L::WIDTH;
+    const OBJECTS: usize = {
+        assert!(L::WIDTH.is_power_of_two() && L::WIDTH <= 64);
+        L::WIDTH
+    };
 }
 
 /// Spans of `N` objects.
 pub(crate) struct Width<const N: usize>;
 
 impl<const N: usize> SpanWidth for Width<N> {
-    const OBJECTS: usize = N;
-}
-
-/// The active set's spans of `W::OBJECTS` objects, ascending: the one decoder of
-/// [`Active`]. Spans with no active object are skipped, a whole empty mask word at a time.
-pub(crate) struct Spans<'a, W> {
-    active: Active<'a>,
-    len: usize,
-    /// The next span's start, or the next position in an index list.
-    at: usize,
-    width: PhantomData<W>,
-}
-
-impl<'a, W: SpanWidth> Spans<'a, W> {
-    /// Spans of `W::OBJECTS` objects.
-    const W: usize = {
-        assert!(W::OBJECTS.is_power_of_two() && W::OBJECTS <= 64);
-        W::OBJECTS
+    const OBJECTS: usize = {
+        assert!(N.is_power_of_two() && N <= 64);
+        N
     };
+}
 
-    /// The spans of `active` over `len` objects (the set checked by [`Active::check`]).
+/// The span of `W::OBJECTS` objects at `start`, of `len` objects in all, with these
+/// candidate lanes.
+#[inline(always)]
+fn span<W: SpanWidth>(start: usize, len: usize, lanes: u64) -> Span {
+    let count = W::OBJECTS.min(len - start);
+    Span {
+        start,
+        count,
+        lanes: lanes & low_bits(count),
+    }
+}
+
+/// A scattered active set of one kind, an index list or a mask, checked by
+/// [`Active::check`]: its spans and its lookahead. A walk is generic over it, so that
+/// each compiled loop decodes one kind. (One loop for both kinds tested the kind on every
+/// span and every request, and kept its state on the stack.)
+pub(crate) trait Subset: Copy + core::fmt::Debug {
+    /// The objects its lookahead has not yet requested.
+    type Upcoming: Upcoming;
+    /// Its spans of `W::OBJECTS` objects, of `len` objects in all, ascending; spans with
+    /// no active object are skipped.
+    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span>;
+    /// Its lookahead, nothing requested yet.
+    fn lookahead(self) -> Lookahead<Self::Upcoming>;
+}
+
+/// [`Active::Indices`]: the objects at these indices, strictly ascending.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct List<'a>(pub &'a [u32]);
+
+/// [`Active::Mask`]: the objects whose bit is set.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Mask<'a>(pub &'a [u64]);
+
+impl<'a> Subset for List<'a> {
+    type Upcoming = ListAhead<'a>;
     #[inline(always)]
-    pub fn new(active: Active<'a>, len: usize) -> Self {
-        Self {
-            active,
+    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
+        ListSpans::<W> {
+            ix: self.0,
             len,
             at: 0,
             width: PhantomData,
         }
     }
-
-    /// The span at `start` with these candidate lanes.
     #[inline(always)]
-    fn span(&self, start: usize, lanes: u64) -> Span {
-        let count = Self::W.min(self.len - start);
-        Span {
-            start,
-            count,
-            lanes: lanes & low_bits(count),
-        }
+    fn lookahead(self) -> Lookahead<ListAhead<'a>> {
+        Lookahead::new(ListAhead(self.0.iter()))
     }
 }
 
-impl<W: SpanWidth> Iterator for Spans<'_, W> {
+impl<'a> Subset for Mask<'a> {
+    type Upcoming = MaskAhead<'a>;
+    #[inline(always)]
+    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
+        MaskSpans::<W> {
+            words: self.0,
+            len,
+            at: 0,
+            width: PhantomData,
+        }
+    }
+    #[inline(always)]
+    fn lookahead(self) -> Lookahead<MaskAhead<'a>> {
+        Lookahead::new(MaskAhead {
+            words: self.0,
+            word: 0,
+            bits: self.0.first().copied().unwrap_or(0),
+        })
+    }
+}
+
+/// An index list's spans.
+struct ListSpans<'a, W> {
+    ix: &'a [u32],
+    len: usize,
+    /// The next position in the list.
+    at: usize,
+    width: PhantomData<W>,
+}
+
+impl<W: SpanWidth> Iterator for ListSpans<'_, W> {
     type Item = Span;
     #[inline(always)]
     fn next(&mut self) -> Option<Span> {
-        match self.active {
-            Active::All => {
-                let start = self.at;
-                if start >= self.len {
-                    return None;
-                }
-                self.at += Self::W;
-                Some(self.span(start, u64::MAX))
+        let first = *self.ix.get(self.at)? as usize;
+        let start = first - first % W::OBJECTS;
+        let end = start + W::OBJECTS;
+        let mut lanes = 0;
+        while let Some(&i) = self.ix.get(self.at).filter(|&&i| (i as usize) < end) {
+            lanes |= 1 << (i as usize - start);
+            self.at += 1;
+        }
+        Some(span::<W>(start, self.len, lanes))
+    }
+}
+
+/// A mask's spans, straight to the span of the next set bit, a whole empty word at a
+/// time.
+struct MaskSpans<'a, W> {
+    words: &'a [u64],
+    len: usize,
+    /// The next span's start.
+    at: usize,
+    width: PhantomData<W>,
+}
+
+impl<W: SpanWidth> Iterator for MaskSpans<'_, W> {
+    type Item = Span;
+    #[inline(always)]
+    fn next(&mut self) -> Option<Span> {
+        loop {
+            // Past the last object the word is zero or absent: a checked mask has no bit
+            // past it.
+            let start = self.at;
+            let word = *self.words.get(start / 64)?;
+            let rest = word >> (start % 64);
+            if rest == 0 {
+                self.at = (start / 64 + 1) * 64;
+                continue;
             }
-            Active::Mask(words) => loop {
-                // Straight to the span of the next set bit, a whole empty word at a time.
-                // Past the last object the word is zero or absent: a checked mask has no
-                // bit past it.
-                let start = self.at;
-                let word = *words.get(start / 64)?;
-                let rest = word >> (start % 64);
-                if rest == 0 {
-                    self.at = (start / 64 + 1) * 64;
-                    continue;
-                }
-                let next = start + rest.trailing_zeros() as usize;
-                let first = next - next % Self::W;
-                self.at = first + Self::W;
-                return Some(self.span(first, word >> (first % 64)));
-            },
-            Active::Indices(ix) => {
-                let first = *ix.get(self.at)? as usize;
-                let start = first - first % Self::W;
-                let end = start + Self::W;
-                let mut lanes = 0;
-                while let Some(&i) = ix.get(self.at).filter(|&&i| (i as usize) < end) {
-                    lanes |= 1 << (i as usize - start);
-                    self.at += 1;
-                }
-                Some(self.span(start, lanes))
-            }
+            let next = start + rest.trailing_zeros() as usize;
+            let first = next - next % W::OBJECTS;
+            self.at = first + W::OBJECTS;
+            return Some(span::<W>(first, self.len, word >> (first % 64)));
         }
     }
 }
@@ -187,31 +238,47 @@ const AHEAD: usize = 16;
 /// The caller requests the objects itself, as [`Self::requests`] yields them, so that its
 /// requests are its own inlined code: handed a closure, the lane loop called it out of
 /// line, with a third of a 1% update's `perf` samples.
-pub(crate) struct Lookahead<'a> {
-    next: Upcoming<'a>,
+pub(crate) struct Lookahead<U> {
+    next: U,
     /// The requests due: [`AHEAD`] at first, one more for each scattered object that
     /// starts running ([`Self::advance`]), and set again around whole spans
     /// ([`Self::enter`]).
     due: usize,
 }
 
-/// The active objects not yet requested, in order.
-enum Upcoming<'a> {
-    /// [`Active::All`]: none are requested.
-    None,
-    /// An index list's own entries: a list needs no decoding, and its walk one object at
-    /// a time is the hot loop of a sparse update (decoded as spans of one object, it put a
-    /// division by the span width in that loop).
-    List(core::slice::Iter<'a, u32>),
-    /// A mask's set bits.
-    Mask(MaskAhead<'a>),
+/// The active objects of one kind of [`Subset`] that its lookahead has not yet requested,
+/// in order.
+pub(crate) trait Upcoming {
+    /// The next one.
+    fn next(&mut self) -> Option<usize>;
+    /// Before `span` runs: skips or seeks past it, and sets the requests `due`, as
+    /// [`Lookahead::enter`] describes.
+    fn enter(&mut self, span: Span, due: &mut usize);
+}
+
+/// An index list's own entries: a list needs no decoding, and its walk one object at a
+/// time is the hot loop of a sparse update (decoded as spans of one object, it put a
+/// division by the span width in that loop).
+pub(crate) struct ListAhead<'a>(core::slice::Iter<'a, u32>);
+
+impl Upcoming for ListAhead<'_> {
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        self.0.next().map(|&i| i as usize)
+    }
+    #[inline(always)]
+    fn enter(&mut self, span: Span, _: &mut usize) {
+        if span.is_full() {
+            self.0.nth(span.count - 1);
+        }
+    }
 }
 
 /// A mask's set bits from a position on. Whole spans cost nothing: the position stays
 /// where it is, and the first scattered span after them moves it past itself in one step.
 /// (Walked bit by bit across whole spans, as spans of one object, the lookahead took about
 /// a third of a dense masked update's time.)
-struct MaskAhead<'a> {
+pub(crate) struct MaskAhead<'a> {
     words: &'a [u64],
     /// The word of `bits`.
     word: usize,
@@ -230,18 +297,6 @@ impl MaskAhead<'_> {
             }
     }
 
-    /// The next set bit's object.
-    #[inline(always)]
-    fn next(&mut self) -> Option<usize> {
-        while self.bits == 0 {
-            self.bits = *self.words.get(self.word + 1)?;
-            self.word += 1;
-        }
-        let i = 64 * self.word + self.bits.trailing_zeros() as usize;
-        self.bits &= self.bits - 1;
-        Some(i)
-    }
-
     /// Past `end`, the first object not yet requested.
     #[inline(always)]
     fn seek(&mut self, end: usize) {
@@ -254,25 +309,38 @@ impl MaskAhead<'_> {
     }
 }
 
-impl<'a> Lookahead<'a> {
-    /// The lookahead of `active`, nothing requested yet.
+impl Upcoming for MaskAhead<'_> {
     #[inline(always)]
-    pub fn new(active: Active<'a>) -> Self {
-        let next = match active {
-            Active::All => Upcoming::None,
-            Active::Indices(ix) => Upcoming::List(ix.iter()),
-            Active::Mask(words) => Upcoming::Mask(MaskAhead {
-                words,
-                word: 0,
-                bits: words.first().copied().unwrap_or(0),
-            }),
-        };
+    fn next(&mut self) -> Option<usize> {
+        while self.bits == 0 {
+            self.bits = *self.words.get(self.word + 1)?;
+            self.word += 1;
+        }
+        let i = 64 * self.word + self.bits.trailing_zeros() as usize;
+        self.bits &= self.bits - 1;
+        Some(i)
+    }
+    #[inline(always)]
+    fn enter(&mut self, span: Span, due: &mut usize) {
+        if span.is_full() {
+            *due = AHEAD.min(*due + span.count);
+        } else if self.position() < span.start {
+            self.seek(span.start + span.count);
+            *due = AHEAD;
+        }
+    }
+}
+
+impl<U: Upcoming> Lookahead<U> {
+    /// The lookahead of these objects, nothing requested yet.
+    #[inline(always)]
+    fn new(next: U) -> Self {
         Self { next, due: AHEAD }
     }
 
     /// The objects to request now: those due, or fewer where the set ends.
     #[inline(always)]
-    pub fn requests(&mut self) -> Requests<'_, 'a> {
+    pub fn requests(&mut self) -> Requests<'_, U> {
         Requests(self)
     }
 
@@ -284,22 +352,7 @@ impl<'a> Lookahead<'a> {
     /// prefetcher was following).
     #[inline(always)]
     pub fn enter(&mut self, span: Span) {
-        match &mut self.next {
-            Upcoming::None => {}
-            Upcoming::List(ix) => {
-                if span.is_full() {
-                    ix.nth(span.count - 1);
-                }
-            }
-            Upcoming::Mask(mask) => {
-                if span.is_full() {
-                    self.due = AHEAD.min(self.due + span.count);
-                } else if mask.position() < span.start {
-                    mask.seek(span.start + span.count);
-                    self.due = AHEAD;
-                }
-            }
-        }
+        self.next.enter(span, &mut self.due);
     }
 
     /// Before `objects` scattered objects run: as many more requests due, so that the next
@@ -311,9 +364,9 @@ impl<'a> Lookahead<'a> {
 }
 
 /// The objects a [`Lookahead`] requests now, in order.
-pub(crate) struct Requests<'l, 'a>(&'l mut Lookahead<'a>);
+pub(crate) struct Requests<'l, U>(&'l mut Lookahead<U>);
 
-impl Iterator for Requests<'_, '_> {
+impl<U: Upcoming> Iterator for Requests<'_, U> {
     type Item = usize;
     #[inline(always)]
     fn next(&mut self) -> Option<usize> {
@@ -321,11 +374,7 @@ impl Iterator for Requests<'_, '_> {
         if ahead.due == 0 {
             return None;
         }
-        let i = match &mut ahead.next {
-            Upcoming::None => None,
-            Upcoming::List(ix) => ix.next().map(|&i| i as usize),
-            Upcoming::Mask(mask) => mask.next(),
-        }?;
+        let i = ahead.next.next()?;
         ahead.due -= 1;
         Some(i)
     }
@@ -337,9 +386,9 @@ mod tests {
     use alloc::vec::Vec;
 
     /// The objects of the spans, in order.
-    fn objects<W: SpanWidth>(active: Active<'_>, len: usize) -> Vec<usize> {
+    fn objects<W: SpanWidth>(set: impl Subset, len: usize) -> Vec<usize> {
         let mut out = Vec::new();
-        for s in Spans::<W>::new(active, len) {
+        for s in set.spans::<W>(len) {
             assert_eq!(s.start % W::OBJECTS, 0);
             assert_eq!(s.count, W::OBJECTS.min(len - s.start));
             assert_ne!(s.lanes, 0);
@@ -364,18 +413,21 @@ mod tests {
             words[i as usize / 64] |= 1 << (i % 64);
         }
         let expected: Vec<usize> = indices.iter().map(|&i| i as usize).collect();
-        let sets = [Active::All, Active::Indices(&indices), Active::Mask(&words)];
-        let every = (0..len).collect::<Vec<_>>();
-        for (set, expected) in sets.into_iter().zip([&every, &expected, &expected]) {
-            assert_eq!(&objects::<Width<1>>(set, len), expected);
-            assert_eq!(&objects::<Width<8>>(set, len), expected);
-            assert_eq!(&objects::<Width<16>>(set, len), expected);
-            assert_eq!(&objects::<Width<64>>(set, len), expected);
-        }
-        assert!(objects::<Width<1>>(Active::Indices(&[]), len).is_empty());
-        assert!(objects::<Width<8>>(Active::Indices(&[]), len).is_empty());
-        assert!(objects::<Width<16>>(Active::Indices(&[]), len).is_empty());
-        assert!(objects::<Width<64>>(Active::Indices(&[]), len).is_empty());
+        assert_eq!(objects::<Width<1>>(List(&indices), len), expected);
+        assert_eq!(objects::<Width<8>>(List(&indices), len), expected);
+        assert_eq!(objects::<Width<16>>(List(&indices), len), expected);
+        assert_eq!(objects::<Width<64>>(List(&indices), len), expected);
+        assert_eq!(objects::<Width<1>>(Mask(&words), len), expected);
+        assert_eq!(objects::<Width<8>>(Mask(&words), len), expected);
+        assert_eq!(objects::<Width<16>>(Mask(&words), len), expected);
+        assert_eq!(objects::<Width<64>>(Mask(&words), len), expected);
+        assert!(objects::<Width<1>>(List(&[]), len).is_empty());
+        assert!(objects::<Width<8>>(List(&[]), len).is_empty());
+        assert!(objects::<Width<16>>(List(&[]), len).is_empty());
+        assert!(objects::<Width<64>>(List(&[]), len).is_empty());
+        let empty = alloc::vec![0u64; len.div_ceil(64)];
+        assert!(objects::<Width<1>>(Mask(&empty), len).is_empty());
+        assert!(objects::<Width<64>>(Mask(&empty), len).is_empty());
     }
 
     /// The lookahead requests active objects only, each once, in order, and each object of
@@ -397,35 +449,40 @@ mod tests {
         for &i in &indices {
             words[i as usize / 64] |= 1 << (i % 64);
         }
-        for set in [Active::Indices(&indices), Active::Mask(&words)] {
-            // Spans run whole (the lane loop), and scattered objects one at a time.
-            let requests = [
-                requests::<Width<4>>(set, len, true),
-                requests::<Width<8>>(set, len, true),
-                requests::<Width<64>>(set, len, true),
-                requests::<Width<8>>(set, len, false),
-                requests::<Width<64>>(set, len, false),
-            ];
-            for requested in requests {
-                assert!(requested.iter().all(|&i| active(i)));
-                assert!(requested.windows(2).all(|w| w[0] < w[1]));
-                // The scattered stretches are long: most of their objects were requested.
-                assert!(requested.len() > indices.len() / 3, "{set:?}");
-            }
+        // Spans run whole (the lane loop), and scattered objects one at a time.
+        check_requests(List(&indices), &active, indices.len(), len);
+        check_requests(Mask(&words), &active, indices.len(), len);
+    }
+
+    /// The requests of a walk of `set` over `len` objects, `count` of them active (those
+    /// for which `active` holds), in spans of several widths.
+    fn check_requests(set: impl Subset, active: &dyn Fn(usize) -> bool, count: usize, len: usize) {
+        let requests = [
+            requests::<Width<4>>(set, len, true),
+            requests::<Width<8>>(set, len, true),
+            requests::<Width<64>>(set, len, true),
+            requests::<Width<8>>(set, len, false),
+            requests::<Width<64>>(set, len, false),
+        ];
+        for requested in requests {
+            assert!(requested.iter().all(|&i| active(i)));
+            assert!(requested.windows(2).all(|w| w[0] < w[1]));
+            // The scattered stretches are long: most of their objects were requested.
+            assert!(requested.len() > count / 3, "{set:?}");
         }
     }
 
     /// The objects requested in a walk of `set` in spans of `W`, the spans run whole or
     /// their objects one at a time, checking that each object of a scattered span was
     /// requested before it runs, except just after whole spans.
-    fn requests<W: SpanWidth>(set: Active<'_>, len: usize, whole: bool) -> Vec<usize> {
+    fn requests<W: SpanWidth>(set: impl Subset, len: usize, whole: bool) -> Vec<usize> {
         let mut requested = Vec::new();
-        let mut ahead = Lookahead::new(set);
+        let mut ahead = set.lookahead();
         requested.extend(ahead.requests());
         // After whole spans, the objects of the next scattered span and the next `AHEAD`
         // objects may run unrequested.
         let (mut excused, mut after_whole) = (0, false);
-        for span in Spans::<W>::new(set, len) {
+        for span in set.spans::<W>(len) {
             ahead.enter(span);
             if whole && !span.is_full() {
                 ahead.advance(span.lanes.count_ones() as usize);

@@ -7,7 +7,7 @@
 //! fused on a default build), and the same contract, the extended path included.
 
 use super::Active;
-use super::active::{Lookahead, Spans, Width};
+use super::active::{List, Mask, Subset, Width};
 use crate::aabb::Aabb3;
 use crate::layout::Maps;
 use crate::method::{Method, Rounding};
@@ -138,6 +138,21 @@ impl<'a, S> AosRun<'a, S> {
     }
 }
 
+/// `$walk(run, poses, tight, $set)` once per method, rounding and pose kind, each
+/// specialised to its kernel.
+macro_rules! each_kernel {
+    ($run:expr, $maps:expr, $walk:ident $(, $set:expr)?) => {{
+        let len = $run.local.len();
+        specialise!($run.method, $run.rounding, |method, rounding| {
+            let tight = Tight { method, rounding };
+            match $maps {
+                Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
+                Maps::Shared(pose) => $walk($run, Shared(pose), tight $(, $set)?),
+            }
+        })
+    }};
+}
+
 /// An [`AosRun`] with its poses, as a job for the class's single-box kernel.
 pub(crate) struct AosOn<'a, T, S> {
     run: AosRun<'a, S>,
@@ -153,68 +168,94 @@ impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
             return false;
         }
         let AosOn { run, maps } = self;
-        let local = run.local;
-        // One loop per method, rounding and pose kind, each specialised to its kernel.
-        specialise!(run.method, run.rounding, |method, rounding| match maps {
-            Maps::Each(poses) => walk(run, &poses[..local.len()], method, rounding),
-            Maps::Shared(pose) => walk(run, Shared(pose), method, rounding),
-        });
+        match run.active {
+            Active::All => every(run, maps),
+            Active::Indices(ix) => each_kernel!(run, maps, list, ix),
+            Active::Mask(words) => each_kernel!(run, maps, mask, words),
+        }
         true
     }
 }
 
-/// Every active object through [`Aabb3::transformed`]: all of them in one run; the objects
-/// of a list one at a time; the spans of a mask, its whole words that follow each other
-/// as one run and the rest one at a time. Scattered objects have their memory requested
-/// ahead, one object further as each runs. `method` and `rounding` are constants at each
-/// call site.
+/// Every object through [`Aabb3::transformed`], in one run. A function of its own, so
+/// that its loop has the registers to itself: compiled into the job beside the scattered
+/// walks, it kept the output pointer on the stack.
+#[inline(never)]
+fn every<T: Transform3, S: AosSink>(run: AosRun<'_, S>, maps: Maps<'_, T>) {
+    each_kernel!(run, maps, whole);
+}
+
+/// [`every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn walk<'p, T: Transform3 + 'p, S: AosSink>(
+fn whole<'p, T: Transform3 + 'p, S: AosSink>(
     run: AosRun<'_, S>,
     poses: impl PoseList<'p, T>,
-    method: Method,
-    rounding: Rounding,
+    tight: Tight,
 ) {
     let AosRun {
-        local,
-        mut sink,
-        active,
-        ..
+        local, mut sink, ..
     } = run;
-    let tight = Tight { method, rounding };
-    if let Active::All = active {
-        sink.run(0, local, poses.from(0), tight);
-        return;
-    }
-    let ahead = |sink: &S, i: usize| {
-        simd::prefetch(&local[i]);
-        simd::prefetch(poses.at(i));
-        sink.prefetch(i);
-    };
-    // Each walk builds its own lookahead, so that the kind of active set is a constant in
-    // its loop.
-    if let Active::Indices(ix) = active {
-        // A list in its order: building each span's mask from a list cost more than the
-        // objects (1.4x at 1% and 10% active, measured on an Intel Xeon).
-        let mut lookahead = Lookahead::new(active);
-        for j in lookahead.requests() {
-            ahead(&sink, j);
-        }
-        for &i in ix {
-            let i = i as usize;
-            lookahead.advance(1);
-            for j in lookahead.requests() {
-                ahead(&sink, j);
-            }
-            sink.one(i, tight.of(&local[i], poses.at(i)));
-        }
-        return;
-    }
-    let mut lookahead = Lookahead::new(active);
+    sink.run(0, local, poses.from(0), tight);
+}
+
+/// Asks for object `i`'s local box, pose and output.
+#[inline(always)]
+fn request<'p, T: 'p, S: AosSink>(
+    local: &[Aabb3],
+    poses: impl PoseList<'p, T>,
+    sink: &S,
+    i: usize,
+) {
+    simd::prefetch(&local[i]);
+    simd::prefetch(poses.at(i));
+    sink.prefetch(i);
+}
+
+/// The objects of a list, one at a time, in its order (building each span's mask from a
+/// list cost more than the objects: 1.4x at 1% and 10% active, measured on an Intel
+/// Xeon). Their memory is requested ahead, one object further as each runs.
+#[inline(always)]
+fn list<'p, T: Transform3 + 'p, S: AosSink>(
+    run: AosRun<'_, S>,
+    poses: impl PoseList<'p, T>,
+    tight: Tight,
+    ix: &[u32],
+) {
+    let AosRun {
+        local, mut sink, ..
+    } = run;
+    let mut lookahead = List(ix).lookahead();
     for j in lookahead.requests() {
-        ahead(&sink, j);
+        request(local, poses, &sink, j);
     }
-    let mut spans = Spans::<Width<SPAN>>::new(active, local.len()).peekable();
+    for &i in ix {
+        let i = i as usize;
+        lookahead.advance(1);
+        for j in lookahead.requests() {
+            request(local, poses, &sink, j);
+        }
+        sink.one(i, tight.of(&local[i], poses.at(i)));
+    }
+}
+
+/// The spans of a mask: its whole words that follow each other as one run, and the rest
+/// one at a time. The scattered objects' memory is requested ahead, one object further as
+/// each runs.
+#[inline(always)]
+fn mask<'p, T: Transform3 + 'p, S: AosSink>(
+    run: AosRun<'_, S>,
+    poses: impl PoseList<'p, T>,
+    tight: Tight,
+    words: &[u64],
+) {
+    let AosRun {
+        local, mut sink, ..
+    } = run;
+    let mut lookahead = Mask(words).lookahead();
+    for j in lookahead.requests() {
+        request(local, poses, &sink, j);
+    }
+    let mut spans = Mask(words).spans::<Width<SPAN>>(local.len()).peekable();
     while let Some(span) = spans.next() {
         lookahead.enter(span);
         if span.is_full() {
@@ -223,12 +264,8 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
                 lookahead.enter(next);
                 end += next.count;
             }
-            sink.run(
-                span.start,
-                &local[span.start..end],
-                poses.from(span.start),
-                tight,
-            );
+            let start = span.start;
+            sink.run(start, &local[start..end], poses.from(start), tight);
             continue;
         }
         let mut bits = span.lanes;
@@ -236,7 +273,7 @@ fn walk<'p, T: Transform3 + 'p, S: AosSink>(
             let i = span.start + bits.trailing_zeros() as usize;
             lookahead.advance(1);
             for j in lookahead.requests() {
-                ahead(&sink, j);
+                request(local, poses, &sink, j);
             }
             sink.one(i, tight.of(&local[i], poses.at(i)));
             bits &= bits - 1;

@@ -49,7 +49,7 @@ mod aos;
 pub use active::Active;
 pub(crate) use aos::{AosRun, AosSink, Tight};
 
-use active::{Lookahead, Spans};
+use active::{List, Mask, Subset};
 
 use crate::error::BatchError;
 use crate::extended;
@@ -309,7 +309,17 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
     pub fn run(self, backend: Backend, fused: bool) {
         match self.split() {
             (Active::All, run) => simd::dispatch(backend, fused, Every(run)),
-            (active, run) => simd::dispatch(backend, fused, Scattered { run, active }),
+            (Active::Indices(ix), run) => {
+                simd::dispatch(backend, fused, Scattered { run, set: List(ix) })
+            }
+            (Active::Mask(words), run) => simd::dispatch(
+                backend,
+                fused,
+                Scattered {
+                    run,
+                    set: Mask(words),
+                },
+            ),
         }
     }
 
@@ -318,7 +328,11 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
     pub fn run_in<L: LaneArray>(self) {
         match self.split() {
             (Active::All, run) => Job::run::<L>(Every(run)),
-            (active, run) => Job::run::<L>(Scattered { run, active }),
+            (Active::Indices(ix), run) => Job::run::<L>(Scattered { run, set: List(ix) }),
+            (Active::Mask(words), run) => Job::run::<L>(Scattered {
+                run,
+                set: Mask(words),
+            }),
         }
     }
 
@@ -350,10 +364,10 @@ struct Run<const N: usize, B, P, S> {
 /// Every object: the job of [`Active::All`].
 struct Every<const N: usize, B, P, S>(Run<N, B, P, S>);
 
-/// The objects of a list or a mask.
-struct Scattered<'a, const N: usize, B, P, S> {
+/// The objects of a list or a mask: `A`, a [`Subset`] of one kind.
+struct Scattered<const N: usize, B, P, S, A> {
     run: Run<N, B, P, S>,
-    active: Active<'a>,
+    set: A,
 }
 
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, B, P, S> {
@@ -371,14 +385,16 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, 
     }
 }
 
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Scattered<'_, N, B, P, S> {
+impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
+    for Scattered<N, B, P, S, A>
+{
     /// As for [`Every`].
     #[inline(always)]
     fn run<L: LaneArray>(self) {
-        let (mut run, active) = (self.run.trim(), self.active);
+        let (mut run, set) = (self.run.trim(), self.set);
         let outward = run.rounding == Rounding::Outward;
         specialise!(run.method, |method| {
-            run.spans::<L>(active, method, outward)
+            run.spans::<L>(set, method, outward)
         });
         run.sink.finish();
     }
@@ -409,7 +425,7 @@ where
     S: Sink<N>,
 {
     /// Every object: a plain loop over whole spans, then the tail one lane at a time.
-    /// Walking [`Spans`] here measured up to 1.5x slower on cheap kernels in cache (the
+    /// Walking spans here measured up to 1.5x slower on cheap kernels in cache (the
     /// per-span decoding and mask tests are not free there).
     #[inline(always)]
     fn every<L: LaneArray>(&mut self, method: Method, outward: bool) {
@@ -428,12 +444,12 @@ where
     /// active object runs in lanes (its inactive lanes are computed and ignored), a lone
     /// active object and the tail run in one lane of the same arithmetic.
     #[inline(always)]
-    fn spans<L: LaneArray>(&mut self, active: Active<'_>, method: Method, outward: bool) {
-        let mut ahead = Lookahead::new(active);
+    fn spans<L: LaneArray>(&mut self, set: impl Subset, method: Method, outward: bool) {
+        let mut ahead = set.lookahead();
         for i in ahead.requests() {
             self.prefetch(i);
         }
-        for span in Spans::<L>::new(active, self.len) {
+        for span in set.spans::<L>(self.len) {
             // A scattered span's objects: as many more requested.
             ahead.enter(span);
             if !span.is_full() {
