@@ -21,12 +21,19 @@ row it reports the median and the mean over runs of criterion's median, the rati
 after/before of each, and each side's spread over its runs.
 
 Usage:
-    python3 scripts/layout_ab.py BEFORE_DIR AFTER_DIR BENCH [FILTER] [--runs N] [--json OUT]
+    python3 scripts/layout_ab.py BEFORE_DIR AFTER_DIR BENCH [FILTER] [--runs N] [--first-seed S]
+                                 [--add EARLIER.json ...] [--json OUT]
 
 BEFORE_DIR and AFTER_DIR are checkouts of the two trees (`git worktree add ../before REV`).
 BENCH is a criterion bench target (`speed`, `classes`, `broadphase`); FILTER is criterion's
-regular expression (default: every row). Needs the x86_64 Linux default linker, rust-lld.
-Run nothing else meanwhile.
+regular expression (default: every row). The seeds are S, S+1, ... (default 1), so a later
+call with `--first-seed` draws new layouts, and `--add` joins the runs that earlier calls saved
+with `--json` (of the same two trees) to this call's before the table is made. Needs the x86_64
+Linux default linker, rust-lld. Run nothing else meanwhile.
+
+With 5 or more runs a side, the median over runs also keeps a row's figure when one or two
+processes of a side run in a slow state of their own (on a VM, a whole process can run the
+densest kernels 1.2-3.7x slower than the same binary in the next process).
 """
 import argparse
 import json
@@ -92,26 +99,33 @@ def main():
     p.add_argument("bench")
     p.add_argument("filter", nargs="?", default="")
     p.add_argument("--runs", type=int, default=16)
+    p.add_argument("--first-seed", type=int, default=1)
+    p.add_argument("--add", type=pathlib.Path, nargs="*", default=[])
     p.add_argument("--json", type=pathlib.Path)
     a = p.parse_args()
 
     work = pathlib.Path(tempfile.mkdtemp(prefix="layout_ab_"))
     sides = {"before": a.before.resolve(), "after": a.after.resolve()}
+    seeds = range(a.first_seed, a.first_seed + a.runs)
     for side, tree in sides.items():
         command = link_command(tree, a.bench)
-        for seed in range(1, a.runs + 1):
+        for seed in seeds:
             relink(command, work / f"{side}{seed}", seed)
     runs = {"before": [], "after": []}
-    for seed in range(1, a.runs + 1):
+    for seed in seeds:
         for side in ("before", "after") if seed % 2 else ("after", "before"):
             runs[side].append(run(work / f"{side}{seed}", a.filter))
             print(f"{side} run {seed} done", file=sys.stderr, flush=True)
     shutil.rmtree(work)
     if a.json:
         a.json.write_text(json.dumps(runs, indent=1))
+    for earlier in a.add:
+        for side, rows in json.loads(earlier.read_text()).items():
+            runs[side] += rows
+    n = len(runs["before"])
 
     rows = [k for k in runs["before"][0] if all(k in r for r in runs["before"] + runs["after"])]
-    print(f"{a.runs} runs of each tree, each its own code layout and stack offset; per row the "
+    print(f"{n} runs of each tree, each its own code layout and stack offset; per row the "
           "median and the mean over runs of criterion's median\n")
     print("| row | before | after | after/before (medians) | (means) | before spread | after spread |")
     print("|---|---:|---:|---:|---:|---:|---:|")
