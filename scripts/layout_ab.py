@@ -28,7 +28,7 @@ BEFORE_DIR and AFTER_DIR are checkouts of the two trees (`git worktree add ../be
 BENCH is a criterion bench target (`speed`, `classes`, `broadphase`); FILTER is criterion's
 regular expression (default: every row). The seeds are S, S+1, ... (default 1), so a later
 call with `--first-seed` draws new layouts, and `--add` joins the runs that earlier calls saved
-with `--json` (of the same two trees) to this call's before the table is made. Needs the x86_64
+with `--json` (of the same two trees) to this call's runs before the table. Needs the x86_64
 Linux default linker, rust-lld. Run nothing else meanwhile.
 
 With 5 or more runs a side, the median over runs also keeps a row's figure when one or two
