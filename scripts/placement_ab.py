@@ -23,6 +23,7 @@ names the function and `nm -C -S` gives its size. Run nothing else meanwhile.
 import argparse
 import pathlib
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -86,6 +87,7 @@ def main():
             for side in ("before", "after") if rep % 2 else ("after", "before"):
                 for row, ns in run(exes[side, offset], a.filter).items():
                     times.setdefault((row, offset, side), []).append(ns)
+    shutil.rmtree(work)
     print(f"{a.reps} runs per tree and offset; each cell lists criterion's medians\n")
     print("| row | function at (mod 64) | before | after |")
     print("|---|---:|---|---|")
