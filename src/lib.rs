@@ -120,7 +120,9 @@
 //!   [`Method`].
 //! - Empty boxes map to `EMPTY`; NaN anywhere, or a non-finite matrix, to the invalid
 //!   `NAN` box; unbounded faces to the exact unbounded result (a zero entry contributes
-//!   exactly 0); finite inputs that overflow to `±inf`, never NaN. Nothing panics.
+//!   exactly 0); finite inputs that overflow to `±inf`, never NaN. No kernel panics,
+//!   whatever the input (the element accessors [`Soa::get`], [`Block8::get`] and
+//!   [`Block8::set`] panic on an index out of range, as slice indexing does).
 //!
 //! ## Broadphase
 //! [`Batch::update`] rewrites only the fat boxes whose object left them and

@@ -243,3 +243,52 @@ fn rigid3_columns_read_like_the_slice() {
     assert_eq!(from_columns, from_slice);
     assert!(from_slice.iter().all(|b| b.is_valid() && !b.is_empty()));
 }
+
+/// The README, the guide and the crate docs say exactly which calls panic: the element
+/// accessors on an index out of range, as slice indexing does, and nothing else.
+#[test]
+fn the_docs_name_every_panic_of_the_api() {
+    use bvkit::{Aabb3x8, Block8, Soa};
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    let panics = |f: &mut dyn FnMut()| catch_unwind(AssertUnwindSafe(f)).is_err();
+    let mut block: Aabb3x8 = Block8::splat(unit_box());
+    let soa = Soa::from_slice(&[unit_box(); 3]);
+    let soa_get = panics(&mut || {
+        let _ = soa.get(3);
+    });
+    let block_get = panics(&mut || {
+        let _ = block.get(8);
+    });
+    let block_set = panics(&mut || block.set(8, unit_box()));
+    let accessors = [
+        ("Soa::get", soa_get),
+        ("Block8::get", block_get),
+        ("Block8::set", block_set),
+    ];
+    assert!(!panics(&mut || {
+        let _ = (soa.get(2), block.get(7));
+    }));
+    let docs = [
+        ("README.md", include_str!("../README.md")),
+        ("docs/guide.md", include_str!("../docs/guide.md")),
+        ("src/lib.rs", include_str!("../src/lib.rs")),
+    ];
+    for (name, text) in docs {
+        let text = text
+            .replace("//!", "")
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(
+            !text.contains("Nothing panics"),
+            "{name} says nothing panics"
+        );
+        for (accessor, panicked) in accessors {
+            assert!(panicked, "{accessor} out of range did not panic");
+            assert!(
+                text.contains(accessor),
+                "{name} does not name the panic of {accessor}"
+            );
+        }
+    }
+}

@@ -803,6 +803,125 @@ fn large_world_update_fattens_the_relative_box() {
     }
 }
 
+/// Local boxes of every kind an update must take, one AoSoA block of them: plain boxes, an
+/// empty one, an unbounded one, one whose image overflows `f32`, a point, a far one, and
+/// one with a NaN face (the only kind reported moved at every update).
+fn standing_boxes() -> Vec<Aabb3> {
+    let big = f32::MAX * 0.9;
+    vec![
+        Aabb3::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)),
+        Aabb3::EMPTY,
+        Aabb3::new(Vec3A::new(f32::NEG_INFINITY, -1.0, -1.0), Vec3A::ONE),
+        Aabb3::new(Vec3A::splat(-big), Vec3A::splat(big)),
+        Aabb3::new(Vec3A::new(f32::NAN, -1.0, -1.0), Vec3A::ONE),
+        Aabb3::new(Vec3A::splat(2.0), Vec3A::splat(3.0)),
+        Aabb3::new(Vec3A::splat(5.0), Vec3A::splat(5.0)),
+        Aabb3::new(Vec3A::splat(1e30), Vec3A::splat(2e30)),
+    ]
+}
+
+/// Updates twice with the same poses, on every backend, for AoS and AoSoA boxes: the first
+/// call writes every object (the fat boxes start NaN), the second only the NaN one.
+fn check_unchanged_poses_move_nothing(
+    what: &str,
+    update: impl Fn(&Batch, bool, &[Aabb3], &mut Vec<Aabb3>, &mut Moved),
+) {
+    let local = standing_boxes();
+    let nan_box = 4;
+    for backend in Backend::supported() {
+        for method in METHODS {
+            for rounding in ROUNDINGS {
+                for aosoa in [false, true] {
+                    let batch = Batch::new(method, rounding).on(backend).unwrap();
+                    let mut fat = vec![Aabb3::NAN; local.len()];
+                    let mut moved = Moved::new();
+                    update(&batch, aosoa, &local, &mut fat, &mut moved);
+                    assert_eq!(moved.len(), local.len(), "{what}: first update");
+                    let first = fat.clone();
+                    update(&batch, aosoa, &local, &mut fat, &mut moved);
+                    let how = format!("{what} {backend:?} {method:?} {rounding:?} aosoa {aosoa}");
+                    assert_eq!(moved.indices(), &[nan_box as u32], "{how}: second update");
+                    for i in 0..local.len() {
+                        assert!(
+                            i == nan_box || same3(&fat[i], &first[i]),
+                            "{how}: {i} rewritten"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`Batch::update`] with AoS or AoSoA local and fat boxes.
+fn update_layout(
+    batch: &Batch,
+    aosoa: bool,
+    local: &[Aabb3],
+    poses: impl bvkit::PoseSource<3>,
+    fat: &mut Vec<Aabb3>,
+    moved: &mut Moved,
+) {
+    let margin = Margin::new(0.1, 0.2);
+    if aosoa {
+        let (l, mut f) = (Block8::pack(local), Block8::pack(fat));
+        batch
+            .update(margin, Active::All, &l[..], poses, &mut f[..], moved)
+            .unwrap();
+        *fat = Block8::unpack(&f, fat.len());
+    } else {
+        batch
+            .update(margin, Active::All, local, poses, &mut fat[..], moved)
+            .unwrap();
+    }
+}
+
+#[test]
+fn unchanged_poses_move_nothing_after_the_first_update() {
+    let n = standing_boxes().len();
+    let rigid = vec![Rigid3::new(Quat::from_rotation_z(0.5), Vec3A::X); n];
+    let large = vec![LargeRigid3::new(Quat::from_rotation_z(0.5), DVec3::new(1e9, 0.0, 0.0)); n];
+    let daffine = vec![DAffine3::from_rotation_z(0.5); n];
+    let origin = DVec3::new(1e9 - 3.0, 0.0, 0.0);
+    let world = LargeWorld {
+        poses: &large[..],
+        origin,
+    };
+    let dworld = LargeWorld {
+        poses: &daffine[..],
+        origin,
+    };
+    check_unchanged_poses_move_nothing("rigid3", |b, s, l, f, m| {
+        update_layout(b, s, l, &rigid[..], f, m)
+    });
+    check_unchanged_poses_move_nothing("large rigid3", |b, s, l, f, m| {
+        update_layout(b, s, l, world, f, m)
+    });
+    check_unchanged_poses_move_nothing("large daffine3", |b, s, l, f, m| {
+        update_layout(b, s, l, dworld, f, m)
+    });
+    check_unchanged_poses_move_nothing("swept rigid3", |b, s, l, f, m| {
+        let swept = Swept {
+            current: &rigid[..],
+            predicted: &rigid[..],
+        };
+        update_layout(b, s, l, swept, f, m)
+    });
+    check_unchanged_poses_move_nothing("swept large", |b, s, l, f, m| {
+        update_layout(
+            b,
+            s,
+            l,
+            Swept {
+                current: world,
+                predicted: dworld,
+            },
+            f,
+            m,
+        )
+    });
+}
+
 // ---------------------------------------------------------------------------------------
 // Refusals.
 

@@ -127,7 +127,10 @@ impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self.poses[i]);
     }
-    /// One object at a time: the `f64` steps have no lane form.
+    /// One object at a time: the `f64` steps have no lane form. A box with a non-finite
+    /// face (empty, unbounded, overflowing or NaN) does not stand: the sinks compare lanes
+    /// of finite faces only (`fat::outside`, where `inf − inf` is NaN), so such an object
+    /// goes to the sink's one-object path, which takes any faces.
     #[inline(always)]
     fn tight<L: LaneArray>(
         &self,
@@ -138,6 +141,7 @@ impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
         method: Method,
         _: bool,
     ) -> (Vector<L, 3>, Vector<L, 3>, L) {
+        let mut redo = L::splat(0.0);
         for k in 0..count {
             let lane = |v: &Vector<L, 3>| v.0.map(|x| x.get(k));
             let [min, max] = self.tight_one(i + k, lane(&lo), lane(&hi), method, Rounding::Outward);
@@ -145,8 +149,11 @@ impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
                 lo.0[a].set(k, min[a]);
                 hi.0[a].set(k, max[a]);
             }
+            if !min.iter().chain(&max).all(|x| x.is_finite()) {
+                redo.set(k, 1.0);
+            }
         }
-        (lo, hi, L::splat(0.0))
+        (lo, hi, redo)
     }
     fn tight_one(
         &self,
@@ -351,10 +358,21 @@ impl<F> Fat<'_, F> {
     {
         let redo_lanes = u64::from(stands.nonzero_mask()) & lanes;
         let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
-        if left != 0 {
-            // The whole span is stored, the lanes that stay with their own bits: lanes
-            // picked by a dynamic index would pin the vectors to memory and stop LLVM from
-            // vectorising the span.
+        if left != 0 && lanes != u64::MAX >> (64 - count) {
+            // A span shared with inactive objects: only the boxes rewritten are stored, so
+            // that an inactive object's fat box is never written.
+            let (grown_min, grown_max) = self.margin.grow(min, max);
+            let mut bits = left;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                let lane = |v: &Vector<L, N>| v.0.map(|x| x.get(k));
+                self.fat.set(i + k, lane(&grown_min), lane(&grown_max));
+                bits &= bits - 1;
+            }
+        } else if left != 0 {
+            // Every object of the span is active: the whole span is stored, the lanes that
+            // stay with their own bits. Lanes picked by a dynamic index would pin the
+            // vectors to memory and stop LLVM from vectorising the span.
             let (grown_min, grown_max) = self.margin.grow(min, max);
             // Negative where the box is rewritten. `outside` is 0 where a box stays and at
             // least 1 where it left, so where every lane is active and stands its negation
@@ -452,5 +470,132 @@ impl AosSink for AosFat<'_> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         simd::prefetch(&self.fat[i]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::Active;
+    use crate::layout::{Aabb3x8, Block8, Rigid3x8, Soa};
+    use crate::transform::Rigid3;
+    use core::cell::Cell;
+    use glam::{Quat, Vec3A};
+
+    /// A fat sink that records, in a bit per object, every box written through it.
+    struct Spy<'w, F> {
+        fat: F,
+        written: &'w Cell<u64>,
+    }
+
+    impl<const N: usize, F: WriteBoxes<N>> WriteBoxes<N> for Spy<'_, F> {
+        fn len(&mut self) -> Result<usize, BatchError> {
+            self.fat.len()
+        }
+        fn store<L: LaneArray>(
+            &mut self,
+            i: usize,
+            count: usize,
+            min: Vector<L, N>,
+            max: Vector<L, N>,
+        ) {
+            self.written
+                .set(self.written.get() | (u64::MAX >> (64 - count)) << i);
+            self.fat.store(i, count, min, max);
+        }
+        fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
+            self.written.set(self.written.get() | 1 << i);
+            self.fat.set(i, min, max);
+        }
+        type Read<'r>
+            = F::Read<'r>
+        where
+            Self: 'r;
+        fn read(&self) -> Self::Read<'_> {
+            self.fat.read()
+        }
+        type Trimmed = Self;
+        fn trim(self, _: usize) -> Self {
+            self
+        }
+        #[cfg(feature = "rayon")]
+        type Part<'p>
+            = F::Part<'p>
+        where
+            Self: 'p;
+        #[cfg(feature = "rayon")]
+        fn parts(&mut self, chunk: usize) -> alloc::vec::Vec<Self::Part<'_>> {
+            self.fat.parts(chunk)
+        }
+    }
+
+    #[test]
+    fn inactive_objects_are_never_written() {
+        // Every active object leaves its (empty) fat box; every other object is inactive,
+        // so each span of the lane loop mixes the two.
+        let n = 40;
+        let local = alloc::vec![Aabb3::new(Vec3A::splat(-1.0), Vec3A::ONE); n];
+        let poses: alloc::vec::Vec<Rigid3> = (0..n)
+            .map(|i| Rigid3::new(Quat::from_rotation_z(i as f32), Vec3A::X * i as f32))
+            .collect();
+        let mask = [0x55_5555_5555_u64];
+        let indices: alloc::vec::Vec<u32> = (0..n as u32).filter(|i| i % 3 == 0).collect();
+        let (l8, p8): (alloc::vec::Vec<Aabb3x8>, alloc::vec::Vec<Rigid3x8>) =
+            (Block8::pack(&local), Block8::pack(&poses));
+        let (ls, ps) = (Soa::from_slice(&local), Soa::from_slice(&poses));
+        for backend in crate::Backend::supported() {
+            for (active, set) in [
+                (Active::Mask(&mask), mask[0]),
+                (
+                    Active::Indices(&indices),
+                    indices.iter().map(|&i| 1 << i).sum(),
+                ),
+            ] {
+                for deterministic in [false, true] {
+                    let mut batch = Batch::new(Method::AbsMatrix, Rounding::Outward)
+                        .on(backend)
+                        .unwrap();
+                    if deterministic {
+                        batch = batch.deterministic();
+                    }
+                    let margin = Margin::new(0.1, 0.0);
+                    let mut moved = Moved::new();
+                    let written = Cell::new(0);
+                    let what = alloc::format!("{backend:?} {active:?} {deterministic}");
+
+                    let mut fat = alloc::vec![Aabb3::EMPTY; n];
+                    let spy = Spy {
+                        fat: &mut fat[..],
+                        written: &written,
+                    };
+                    batch
+                        .update(margin, active, &local[..], &poses[..], spy, &mut moved)
+                        .unwrap();
+                    assert_eq!(written.get(), set, "AoS {what}");
+
+                    written.set(0);
+                    let mut fat8: alloc::vec::Vec<Aabb3x8> = Block8::pack(&[Aabb3::EMPTY; 40]);
+                    let spy = Spy {
+                        fat: &mut fat8[..],
+                        written: &written,
+                    };
+                    batch
+                        .update(margin, active, &l8[..], &p8[..], spy, &mut moved)
+                        .unwrap();
+                    assert_eq!(written.get(), set, "AoSoA {what}");
+
+                    written.set(0);
+                    let mut fats = Soa::<Aabb3>::from_slice(&[Aabb3::EMPTY; 40]);
+                    let spy = Spy {
+                        fat: &mut fats,
+                        written: &written,
+                    };
+                    batch
+                        .update(margin, active, &ls, &ps, spy, &mut moved)
+                        .unwrap();
+                    assert_eq!(written.get(), set, "SoA {what}");
+                }
+            }
+        }
     }
 }
