@@ -3,7 +3,7 @@
 #[cfg(feature = "rayon")]
 mod parallel;
 
-use crate::engine::{Active, AosRun, Engine, Poses, Store};
+use crate::engine::{Active, All, AosRun, Engine, Poses, Store};
 use crate::error::BatchError;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, ReadMaps, TransformSource, WriteBoxes};
 use crate::method::{Method, Rounding};
@@ -130,7 +130,7 @@ impl Batch {
             let run = AosRun {
                 local: boxes,
                 sink,
-                active: Active::All,
+                active: All,
                 method: self.method,
                 rounding: self.rounding,
             };
@@ -150,7 +150,7 @@ impl Batch {
             method: self.method,
             rounding: self.rounding,
         };
-        engine.run(self.backend, !self.deterministic);
+        engine.run_every(self.backend, !self.deterministic);
         Ok(())
     }
 }

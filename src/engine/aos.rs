@@ -118,22 +118,22 @@ impl<'p, T> PoseList<'p, T> for Shared<'p, T> {
 
 /// A run of the AoS loop, its lengths and its active set checked: everything but the
 /// poses, which the pose source adds ([`AosRun::with`]).
-pub(crate) struct AosRun<'a, S> {
+pub(crate) struct AosRun<'a, S, A> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// Where the tight boxes go.
     pub sink: S,
-    /// The objects visited.
-    pub active: Active<'a>,
+    /// The objects visited: [`All`] or an [`Active`] set.
+    pub active: A,
     /// The method.
     pub method: Method,
     /// The rounding.
     pub rounding: Rounding,
 }
 
-impl<'a, S> AosRun<'a, S> {
+impl<'a, S, A> AosRun<'a, S, A> {
     /// The run with its poses, one per object or shared.
-    pub fn with<T>(self, maps: Maps<'a, T>) -> AosOn<'a, T, S> {
+    pub fn with<T>(self, maps: Maps<'a, T>) -> AosOn<'a, T, S, A> {
         AosOn { run: self, maps }
     }
 }
@@ -153,13 +153,43 @@ macro_rules! each_kernel {
     }};
 }
 
+/// The objects an AoS run visits, as a type, so that a run compiles only the walks it
+/// can take: [`All`] (a batch transform, the one loop over every object) or an update's
+/// [`Active`] set (that loop, an index list's and a mask's).
+pub(crate) trait AosActive: Copy {
+    /// Runs `run` with `maps` over these objects.
+    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>);
+}
+
+/// Every object, known when the run is compiled.
+#[derive(Clone, Copy)]
+pub(crate) struct All;
+
+impl AosActive for All {
+    #[inline(always)]
+    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>) {
+        every(run, maps);
+    }
+}
+
+impl AosActive for Active<'_> {
+    #[inline(always)]
+    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>) {
+        match run.active {
+            Active::All => every(run, maps),
+            Active::Indices(ix) => each_kernel!(run, maps, list, ix),
+            Active::Mask(words) => each_kernel!(run, maps, mask, words),
+        }
+    }
+}
+
 /// An [`AosRun`] with its poses, as a job for the class's single-box kernel.
-pub(crate) struct AosOn<'a, T, S> {
-    run: AosRun<'a, S>,
+pub(crate) struct AosOn<'a, T, S, A> {
+    run: AosRun<'a, S, A>,
     maps: Maps<'a, T>,
 }
 
-impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
+impl<T, S: AosSink, A: AosActive> Simd3Job<T> for AosOn<'_, T, S, A> {
     fn run(self, backend: Backend) -> bool
     where
         T: Transform3,
@@ -167,12 +197,7 @@ impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
         if let Backend::Scalar | Backend::Wide = backend {
             return false;
         }
-        let AosOn { run, maps } = self;
-        match run.active {
-            Active::All => every(run, maps),
-            Active::Indices(ix) => each_kernel!(run, maps, list, ix),
-            Active::Mask(words) => each_kernel!(run, maps, mask, words),
-        }
+        A::walk(self.run, self.maps);
         true
     }
 }
@@ -181,14 +206,14 @@ impl<T, S: AosSink> Simd3Job<T> for AosOn<'_, T, S> {
 /// that its loop has the registers to itself: compiled into the job beside the scattered
 /// walks, it kept the output pointer on the stack.
 #[inline(never)]
-fn every<T: Transform3, S: AosSink>(run: AosRun<'_, S>, maps: Maps<'_, T>) {
+fn every<T: Transform3, S: AosSink, A>(run: AosRun<'_, S, A>, maps: Maps<'_, T>) {
     each_kernel!(run, maps, whole);
 }
 
 /// [`every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, S: AosSink>(
-    run: AosRun<'_, S>,
+fn whole<'p, T: Transform3 + 'p, S: AosSink, A>(
+    run: AosRun<'_, S, A>,
     poses: impl PoseList<'p, T>,
     tight: Tight,
 ) {
@@ -216,7 +241,7 @@ fn request<'p, T: 'p, S: AosSink>(
 /// Xeon). Their memory is requested ahead, one object further as each runs.
 #[inline(always)]
 fn list<'p, T: Transform3 + 'p, S: AosSink>(
-    run: AosRun<'_, S>,
+    run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
     tight: Tight,
     ix: &[u32],
@@ -243,7 +268,7 @@ fn list<'p, T: Transform3 + 'p, S: AosSink>(
 /// each runs.
 #[inline(always)]
 fn mask<'p, T: Transform3 + 'p, S: AosSink>(
-    run: AosRun<'_, S>,
+    run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
     tight: Tight,
     words: &[u64],

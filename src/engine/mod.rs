@@ -47,7 +47,7 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{AosRun, AosSink, Tight};
+pub(crate) use aos::{All, AosActive, AosRun, AosSink, Tight};
 
 use active::{List, Mask, Subset};
 
@@ -93,7 +93,7 @@ pub(crate) trait Poses<const N: usize> {
     }
     /// Runs `run` (AoS 3D boxes) on the single-box kernel and returns true, or returns
     /// false where these poses or the backend have none.
-    fn run_aos<S: AosSink>(&self, run: AosRun<'_, S>, backend: Backend) -> bool {
+    fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
         let _ = (run, backend);
         false
     }
@@ -143,7 +143,7 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     fn trim(self, len: usize) -> X::Trimmed {
         ReadMaps::trim(self, len)
     }
-    fn run_aos<S: AosSink>(&self, run: AosRun<'_, S>, backend: Backend) -> bool {
+    fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
         match self.maps() {
             Some(maps) => X::Class::run_simd3(run.with(maps), backend),
             None => false,
@@ -321,6 +321,15 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
                 },
             ),
         }
+    }
+
+    /// [`Engine::run`] where the active set is [`Active::All`] (a batch transform): the
+    /// one job that needs, so that a transform's call site compiles no scattered walk (a
+    /// third of the lane loops that [`Engine::run`] compiles).
+    #[inline(always)]
+    pub fn run_every(self, backend: Backend, fused: bool) {
+        debug_assert_eq!(self.active, Active::All);
+        simd::dispatch(backend, fused, Every(self.split().1));
     }
 
     /// [`Engine::run`] in lanes of type `L`, without the dispatch.
