@@ -1,11 +1,12 @@
 //! Batch kernels at L1, L2 and DRAM sizes, per layout and backend, with peers and the memory
-//! roofline in the same run. `cargo bench --bench batch`.
+//! roofline in the same run. `cargo bench --features peers --bench batch`.
 
 use bvkit_support::common;
 
 use std::hint::black_box;
 
 use bvkit::{Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Backend, Batch, Method, Rounding};
+use bvkit_support::criterion;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 use common::*;

@@ -1,6 +1,6 @@
 //! The broadphase update at 1M objects with 1%, 10% and 100% active, in ns per active
 //! object, next to the memory roofline of the bytes it moves and the naive path that
-//! rewrites every box. `cargo bench --bench broadphase`; `scripts/broadphase_report.py`
+//! rewrites every box. `cargo bench --features peers --bench broadphase`; `scripts/broadphase_report.py`
 //! tabulates a run.
 //!
 //! Two cases per fraction: `stay` (no object leaves its fat box: the update reads the
@@ -23,6 +23,7 @@ use bvkit_support::common;
 use std::hint::black_box;
 
 use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3, Rigid3x8, Rounding};
+use bvkit_support::criterion;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3A;
 

@@ -1,6 +1,6 @@
 //! Per transform class: ns per box in cache (4K boxes) and from DRAM (4M boxes), AoSoA and
 //! AoS on the best backend, against a memory roofline that moves that class's bytes, with
-//! the peers on the same poses in the same run. `cargo bench --bench classes`.
+//! the peers on the same poses in the same run. `cargo bench --features peers --bench classes`.
 //!
 //! Bytes per box (AoSoA, read + written): box 24 + output 24 + the class's fields:
 //! translation 12 (60), rigid 28 (76), similarity 32 (80), scale-rotation-translation 40
@@ -11,6 +11,7 @@ use bvkit_support::common;
 use std::hint::black_box;
 
 use bvkit::{Aabb3, Aabb3x8, Batch, Block8, Method, Rounding, Transform3};
+use bvkit_support::criterion;
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
 
 use common::*;

@@ -1,5 +1,5 @@
 //! Single-box kernels over a loop of 1024 boxes, with peers in the same group.
-//! `cargo bench --bench single`.
+//! `cargo bench --features peers --bench single`.
 
 use bvkit_support::common;
 
@@ -7,6 +7,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use bvkit::{Aabb2, Aabb3, Method, Rigid2, Rounding};
+use bvkit_support::criterion;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec2;
 

@@ -3,7 +3,7 @@
 //! rooflines, at 256 (L1), 1K, 64K and 4M boxes, for affine maps and rigid poses; and in
 //! cache (256, 1K) the translation class in every layout against a glam translation loop,
 //! and the 2D classes as AoS slices. The CPU and the backend are printed first.
-//! `cargo bench --bench speed`; `scripts/bench_report.py speed` tabulates a run.
+//! `cargo bench --features peers --bench speed`; `scripts/bench_report.py speed` tabulates a run.
 
 use bvkit_support::common;
 
@@ -13,6 +13,7 @@ use bvkit::{
     Aabb2, Aabb3, Aabb3x8, AabbSoa, Affine3Soa, Affine3x8, Batch, Block8, Method, Rigid2, Rigid3,
     Rigid3x8, Rounding, Soa, Translation2, Translation3,
 };
+use bvkit_support::criterion;
 use criterion::measurement::WallTime;
 use criterion::{
     BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main,

@@ -2,9 +2,10 @@
 //! (5k and 20k triangles) and two copies of spot, each at 200 seeded poses. One iteration
 //! runs all 200 queries: divide by 200 for the time per query. Node pairs per query and
 //! bytes per triangle are printed once before the timings (`examples/trees.rs` prints the
-//! full comparison). `cargo bench --bench trees`.
+//! full comparison). `cargo bench --features peers --bench trees`.
 
 use bvkit_support::common;
+use bvkit_support::parry3d;
 use bvkit_support::trimesh;
 
 use std::hint::black_box;
@@ -13,6 +14,7 @@ use std::time::Duration;
 
 use bvkit::Rigid3;
 use bvkit::tree::{Quantized, TriMesh};
+use bvkit_support::criterion;
 use criterion::{Criterion, criterion_group, criterion_main};
 use parry3d::bounding_volume::BoundingVolume;
 use parry3d::math::Pose;

@@ -5,9 +5,10 @@
 //! same run. Prints a Markdown table (µs per query, node pairs per query, bytes per
 //! triangle), then the targets of the trees issue, each met or missed.
 //!
-//! `cargo run --release --example trees [--quick]`: with `--quick`, 8 poses per scene and
+//! `cargo run --release --features peers --example trees [--quick]`: with `--quick`, 8 poses per scene and
 //! one timed run each, to check that the report runs (CI).
 
+use bvkit_support::parry3d;
 use bvkit_support::timing::{self, quick};
 use bvkit_support::trimesh;
 

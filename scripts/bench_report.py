@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tabulates one `cargo bench --bench batch` and `--bench classes` run (criterion's JSON
+"""Tabulates one `cargo bench --features peers --bench batch` and `--bench classes` run (criterion's JSON
 under target/criterion).
 
 Prints, per batch size, ns per box (criterion's median) for every kernel, layout and

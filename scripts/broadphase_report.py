@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tabulates one `cargo bench --bench broadphase` run (criterion's JSON under
+"""Tabulates one `cargo bench --features peers --bench broadphase` run (criterion's JSON under
 target/criterion): per active fraction, ns per active object of the update and of the
 memory roofline of the same accesses, and their ratio, for the `stay` case (no fat box
 rewritten) and the `moved` case (every active fat box rewritten); the naive path; and the

@@ -51,8 +51,10 @@ import tempfile
 def link_command(tree, bench):
     """Builds the bench target of `tree`, keeping its objects, and returns rustc's link command."""
     (tree / "benches" / f"{bench}.rs").touch()  # cargo reruns rustc only for a changed target
+    # The benches need the `peers` feature where the tree has it (from issue 46 on).
+    peers = ["--features", "peers"] if "\npeers = [" in (tree / "Cargo.toml").read_text() else []
     out = subprocess.run(
-        ["cargo", "rustc", "--profile", "bench", "--bench", bench, "--",
+        ["cargo", "rustc", "--profile", "bench", *peers, "--bench", bench, "--",
          "-C", "save-temps", "--print", "link-args"],
         cwd=tree, check=True, stdout=subprocess.PIPE, text=True).stdout  # cargo's stderr shows
     lines = [line for line in out.splitlines() if ' "-o" ' in line]

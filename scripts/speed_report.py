@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tabulates one `cargo bench --bench speed` run (criterion's JSON under target/criterion):
+"""Tabulates one `cargo bench --features peers --bench speed` run (criterion's JSON under target/criterion):
 ns per box (criterion's median) for every path at 256, 1K, 64K and 4M boxes, and the
 targets of the speed issue, each marked met or missed.
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tabulates one `cargo bench --bench trees` run (criterion's JSON under target/criterion):
+"""Tabulates one `cargo bench --features peers --bench trees` run (criterion's JSON under target/criterion):
 per scene and query, µs per query (criterion's median over an iteration of 200 poses) for
 bvkit's compact and quantized trees and for parry3d, and parry3d's time over bvkit's.
 Usage: python3 scripts/trees_report.py [target/criterion]

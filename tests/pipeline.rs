@@ -4,6 +4,7 @@
 //! frame's full traversal or by a change-detection traversal since (an engine keeps a pair
 //! until its boxes separate).
 
+use bvkit_support::parry3d;
 use std::collections::HashSet;
 
 use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};

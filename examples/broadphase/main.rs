@@ -3,12 +3,12 @@
 //! sleep together (as engines put a resting pile to sleep; a fourth argument sets the island
 //! size, 1 for bodies asleep one by one at random). Two modes:
 //!
-//! - `cargo run --release --example broadphase [N] [T] [asleep] [island]`: the fat-box
+//! - `cargo run --release --features peers --example broadphase [N] [T] [asleep] [island]`: the fat-box
 //!   update against the naive path that recomputes and rewrites every box every frame, in
 //!   AoS and AoSoA; each frame prints the update's cost, the fraction of awake bodies whose
 //!   fat box moved and the fat boxes rewritten. After every frame it checks what the update
 //!   promises in each layout: every fat box contains its body's tight box.
-//! - `cargo run --release --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
+//! - `cargo run --release --features peers --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
 //!   [--partial K]`: two whole broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage
 //!   by stage; the options tune bvkit's pipeline.
 

@@ -24,6 +24,7 @@
 //! squares is a lower bound on every capsule's volume. Everything is `f64` on the `f32`
 //! inputs; its rounding (about `10^-15` relative) is far below the four digits reported.
 
+use bvkit_support::parry3d;
 use glam::{DVec2, DVec3, Vec3};
 use std::collections::BinaryHeap;
 

@@ -3,12 +3,13 @@
 //! sphere) and an exhaustive OBB search in the same run. Prints a Markdown table, then the
 //! targets of the fitting issues, each met or missed.
 //!
-//! `cargo run --release --example fit [--quick]`: with `--quick`, two small meshes and one
+//! `cargo run --release --features peers --example fit [--quick]`: with `--quick`, two small meshes and one
 //! timed run each, to check that the report runs (CI).
 
 mod capsule_bound;
 
 use bvkit_support::meshes;
+use bvkit_support::parry3d;
 use bvkit_support::timing::{self, quick};
 
 use bvkit::{Capsule, Fit, Obb3, Sphere};

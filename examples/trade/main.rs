@@ -1,5 +1,6 @@
-//! The speed/accuracy trade of every kernel, measured: `cargo run --release --example trade`.
-//! With `--quick` it runs on small sizes with few runs, to check that it runs (CI).
+//! The speed/accuracy trade of every kernel, measured: `cargo run --release --example trade`
+//! (add `--features peers` for the parry3d loop, which builds parry3d). With `--quick` it
+//! runs on small sizes with few runs, to check that it runs (CI).
 //!
 //! For every transform class (3D translation, rigid, similarity, TRS and affine; 2D
 //! translation, rigid and affine), every method × rounding × layout (single box, AoS, SoA,
@@ -73,5 +74,11 @@ fn main() -> std::io::Result<()> {
         csv_path.display(),
         svg_path.display()
     );
+    if cfg!(not(feature = "peers")) {
+        println!(
+            "\nThe parry3d loop is not in this run: it needs parry3d built, which \
+             `cargo run --release --example trade --features peers` adds."
+        );
+    }
     Ok(())
 }

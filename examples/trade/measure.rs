@@ -519,6 +519,8 @@ pub const AFFINE3_STAGES: usize = 2 + Method::ALL.len() * Rounding::ALL.len();
 pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     progress.stage("3D affine: scene and oracle sample");
     let (boxes, xfs, poses) = common::scene(dram(), 0x3d);
+    #[cfg(not(feature = "peers"))]
+    let _ = poses; // for the parry3d loop
     let (b8, x8) = (Aabb3x8::pack(&boxes), Affine3x8::pack(&xfs));
     let (bs, xs) = (AabbSoa::from_slice(&boxes), Affine3Soa::from_slice(&xfs));
     let (cb, cx) = (
@@ -536,12 +538,15 @@ pub fn affine3d(backends: &[Backend], progress: &Progress) -> Vec<Row> {
     let mut m = Meter::new(TransformClass::Affine3, progress);
 
     progress.stage("3D affine: peers and rooflines");
-    let (pb, pp) = common::parry_scene(&boxes, &poses);
-    let mut op = pb.clone();
-    let t = times(|n| {
-        common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
-    });
-    m.peer(Peer::Parry, t, None);
+    #[cfg(feature = "peers")]
+    {
+        let (pb, pp) = common::parry_scene(&boxes, &poses);
+        let mut op = pb.clone();
+        let t = times(|n| {
+            common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
+        });
+        m.peer(Peer::Parry, t, None);
+    }
     let peer_accuracy = |f: fn(&[Aabb3], &[Affine3A], &mut [Aabb3])| {
         let mut o = vec![Aabb3::EMPTY; sb.len()];
         f(&sb, &sx, &mut o);
@@ -769,13 +774,16 @@ pub fn classes3(best: Backend, progress: &Progress) -> Vec<Row> {
         |p| (p.aabb(), p.rigid3()),
     );
     progress.stage("3D rigid: peers");
-    let (pb, pp) = common::parry_scene(&s.boxes, &s.poses);
-    let mut op = pb.clone();
+    #[cfg(feature = "peers")]
+    {
+        let (pb, pp) = common::parry_scene(&s.boxes, &s.poses);
+        let mut op = pb.clone();
+        let t = times(|n| {
+            common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
+        });
+        m.peer(Peer::Parry, t, None);
+    }
     let mut out = vec![Aabb3::EMPTY; dram()];
-    let t = times(|n| {
-        common::parry_transform_by(black_box(&pb[..n]), black_box(&pp[..n]), &mut op[..n])
-    });
-    m.peer(Peer::Parry, t, None);
     let t = times(|n| {
         common::glam_rigid_abs_matrix(
             black_box(&s.boxes[..n]),

@@ -1,4 +1,5 @@
-//! Inputs, peers and memory rooflines shared by the benches and the trade report.
+//! Inputs, peers and memory rooflines shared by the benches and the trade report; the
+//! parry3d peer and the criterion settings with the `peers` feature.
 #![allow(dead_code)]
 
 use bvkit::Aabb3;
@@ -75,6 +76,7 @@ pub fn glam_abs_matrix(boxes: &[Aabb3], xfs: &[Affine3A], out: &mut [Aabb3]) {
 }
 
 /// parry3d's `Aabb::transform_by` over rigid poses.
+#[cfg(feature = "peers")]
 pub fn parry_transform_by(
     boxes: &[parry3d::bounding_volume::Aabb],
     poses: &[parry3d::math::Pose],
@@ -86,6 +88,7 @@ pub fn parry_transform_by(
 }
 
 /// The parry3d form of a scene.
+#[cfg(feature = "peers")]
 pub fn parry_scene(
     boxes: &[Aabb3],
     poses: &[(Quat, Vec3)],
@@ -265,6 +268,7 @@ pub fn raw<T, const F: usize>(
 }
 
 /// Criterion settings for a group of `n` boxes: fewer, longer samples at DRAM sizes.
+#[cfg(feature = "peers")]
 pub fn configure(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     n: usize,

@@ -7,7 +7,6 @@
 #[cfg(feature = "peers")]
 pub mod broadphase;
 pub mod cases;
-#[cfg(feature = "peers")]
 pub mod common;
 pub mod matrix;
 pub mod meshes;
@@ -18,3 +17,9 @@ pub mod sat;
 pub mod timing;
 pub mod trimesh;
 pub mod volumes;
+
+// The peers, for the benches, examples and tests that compare with them (`peers`).
+#[cfg(feature = "peers")]
+pub use criterion;
+#[cfg(feature = "peers")]
+pub use parry3d;
