@@ -74,11 +74,6 @@ fn main() -> std::io::Result<()> {
         csv_path.display(),
         svg_path.display()
     );
-    if cfg!(not(feature = "peers")) {
-        println!(
-            "\nThe parry3d loop is not in this run: it needs parry3d built, which \
-             `cargo run --release --example trade --features peers` adds."
-        );
-    }
+
     Ok(())
 }

@@ -261,8 +261,13 @@ pub fn targets(rows: &[Row], best: Backend) -> String {
 pub fn method(best: Backend, rows: &[Row]) -> String {
     let (kernels, peers, rooflines) = counts(rows);
     let (cache_runs, dram_runs, cases) = (cache_runs(), dram_runs(), cases());
+    let parry = if rows.iter().any(|r| r.kind == Kind::Peer(Peer::Parry)) {
+        "The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured (the plot draws it as a dashed line at its speed, in the 3D rigid panel)."
+    } else {
+        "The parry3d loop is not in this run: `cargo run --release --example trade --features peers` adds it (and builds parry3d)."
+    };
     format!(
-        "## How this was measured\n\nCPU: {}. Figures differ by vendor: subnormal operands cost an Intel core a microcode assist and an AMD core nothing, and bvkit's kernels form none on normal-range input. Best backend: {best:?} (of {:?}); the 3D affine, 2D rigid and 2D affine batch kernels also run on the scalar backend. ns/box: the median of {cache_runs} runs over {} (inputs and outputs in cache) and of {dram_runs} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({cases} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). The parry3d loop rotates by `q v q*`, the oracle's `R(q)` only for unit quaternions, so its error is not measured (the plot draws it as a dashed line at its speed, in the 3D rigid panel). The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
+        "## How this was measured\n\nCPU: {}. Figures differ by vendor: subnormal operands cost an Intel core a microcode assist and an AMD core nothing, and bvkit's kernels form none on normal-range input. Best backend: {best:?} (of {:?}); the 3D affine, 2D rigid and 2D affine batch kernels also run on the scalar backend. ns/box: the median of {cache_runs} runs over {} (inputs and outputs in cache) and of {dram_runs} runs over {}, each after a warm-up run. Accuracy: every kernel's results against the exact oracle on {} seeded cases ({cases} from each of the classes {ACCURACY_CLASSES:?}), in units of `u·S` (see `bvkit::method`); the peers against the same oracle (they make no containment promise). {parry} The CSV has every row: {kernels} kernel × layout × backend rows, {peers} peers and {rooflines} memory rooflines.\n",
         crate::common::cpu(),
         Backend::supported(),
         boxes(cache()),
