@@ -222,6 +222,8 @@ impl Fields for Aabb2 {
 
 /// A box type of `N` dimensions: its fields are `min` then `max`.
 pub(crate) trait Boxes<const N: usize>: Fields {
+    /// True when this is [`Aabb3`], whose slices [`Boxes::aabb3s`] returns.
+    const AABB3: bool = false;
     /// The slice as 3D boxes, when it is one (for the paired AoS path).
     fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
         let _ = items;
@@ -234,6 +236,7 @@ pub(crate) trait Boxes<const N: usize>: Fields {
     }
 }
 impl Boxes<3> for Aabb3 {
+    const AABB3: bool = true;
     fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
         Some(items)
     }

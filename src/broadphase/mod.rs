@@ -325,6 +325,7 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
+    const AABB3S: bool = F::AABB3S;
     type Trimmed = Fat<'a, F::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Self::Trimmed {

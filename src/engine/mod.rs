@@ -91,6 +91,9 @@ pub(crate) trait Poses<const N: usize> {
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
+    /// True when [`Poses::run_aos`] runs every job on the SIMD backends other than `wide`
+    /// (AoS or shared transforms of a 3D class).
+    const AOS: bool = false;
     /// Runs `run` (AoS 3D boxes) on the single-box kernel and returns true, or returns
     /// false where these poses or the backend have none.
     fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
@@ -143,6 +146,7 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     fn trim(self, len: usize) -> X::Trimmed {
         ReadMaps::trim(self, len)
     }
+    const AOS: bool = X::MAPS;
     fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
         match self.maps() {
             Some(maps) => X::Class::run_simd3(run.with(maps), backend),
@@ -217,6 +221,8 @@ pub(crate) trait Sink<const N: usize> {
     }
     /// After the last span (a fence after streaming stores).
     fn finish(&mut self) {}
+    /// True when the sink writes AoS 3D boxes (which the AoS loop can take instead).
+    const AABB3S: bool = false;
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
@@ -271,6 +277,7 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
             simd::store_fence();
         }
     }
+    const AABB3S: bool = O::AABB3S;
     type Trimmed = Store<O::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Store<O::Trimmed> {
@@ -308,11 +315,11 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
     #[inline(always)]
     pub fn run(self, backend: Backend, fused: bool) {
         match self.split() {
-            (Active::All, run) => simd::dispatch(backend, fused, Every(run)),
+            (Active::All, run) => Self::dispatch(backend, fused, Every(run)),
             (Active::Indices(ix), run) => {
-                simd::dispatch(backend, fused, Scattered { run, set: List(ix) })
+                Self::dispatch(backend, fused, Scattered { run, set: List(ix) })
             }
-            (Active::Mask(words), run) => simd::dispatch(
+            (Active::Mask(words), run) => Self::dispatch(
                 backend,
                 fused,
                 Scattered {
@@ -323,13 +330,30 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
         }
     }
 
+    /// True when every run of these types that a SIMD backend other than `wide` takes fused
+    /// goes to the AoS loop first (AoS 3D boxes in and out, AoS or shared poses: the batch
+    /// transform and the update try [`Poses::run_aos`] whenever the lanes may fuse), so that
+    /// the lanes never run fused AVX2 or AVX-512 code.
+    const AOS: bool = B::AABB3S && P::AOS && S::AABB3S;
+
+    /// [`simd::dispatch`], without the fused AVX2 and AVX-512 lanes where [`Self::AOS`]:
+    /// they were a fifth of the code of an AoS call site.
+    #[inline(always)]
+    fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
+        if Self::AOS {
+            simd::dispatch_in::<J, false>(backend, fused, job);
+        } else {
+            simd::dispatch(backend, fused, job);
+        }
+    }
+
     /// [`Engine::run`] where the active set is [`Active::All`] (a batch transform): the
     /// one job that needs, so that a transform's call site compiles no scattered walk (a
     /// third of the lane loops that [`Engine::run`] compiles).
     #[inline(always)]
     pub fn run_every(self, backend: Backend, fused: bool) {
         debug_assert_eq!(self.active, Active::All);
-        simd::dispatch(backend, fused, Every(self.split().1));
+        Self::dispatch(backend, fused, Every(self.split().1));
     }
 
     /// [`Engine::run`] in lanes of type `L`, without the dispatch.

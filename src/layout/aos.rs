@@ -43,6 +43,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
         let (lo, hi) = box_lanes::<f32, N>(&self[i].to_fields());
         (lo.0, hi.0)
     }
+    const AABB3S: bool = B::AABB3;
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         B::aabb3s(self)
     }
@@ -99,6 +100,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
         v[N..2 * N].copy_from_slice(&max);
         self[i] = B::from_fields(&v);
     }
+    const AABB3S: bool = B::AABB3;
     fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
         B::aabb3s_mut(self)
     }
@@ -125,6 +127,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
     fn get(&self, i: usize) -> T {
         self[i]
     }
+    const MAPS: bool = true;
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Each(self))
     }
@@ -157,6 +160,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
     fn get(&self, _: usize) -> T {
         **self
     }
+    const MAPS: bool = true;
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Shared(self))
     }
@@ -178,6 +182,7 @@ impl<'a, const N: usize, E: Boxes<N>> ReadBoxes<N> for &'a Vec<E> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         ReadBoxes::get(&self.as_slice(), i)
     }
+    const AABB3S: bool = E::AABB3;
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         E::aabb3s(self.as_slice())
     }
@@ -222,6 +227,7 @@ impl<'a, const N: usize, E: Boxes<N>> WriteBoxes<N> for &'a mut Vec<E> {
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);
     }
+    const AABB3S: bool = E::AABB3;
     fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
         E::aabb3s_mut(self.as_mut_slice())
     }
@@ -248,6 +254,7 @@ impl<'a, const N: usize, E: Class<N>> ReadMaps<N> for &'a Vec<E> {
     fn get(&self, i: usize) -> Self::Class {
         ReadMaps::get(&self.as_slice(), i)
     }
+    const MAPS: bool = true;
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {
         Some(Maps::Each(self.as_slice()))
     }

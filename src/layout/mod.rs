@@ -58,6 +58,8 @@ pub(crate) mod sealed {
         fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>);
         /// Box `i` as `(min, max)`, for the extended path.
         fn get(&self, i: usize) -> ([f32; N], [f32; N]);
+        /// True when [`ReadBoxes::aabb3s`] always returns the boxes.
+        const AABB3S: bool = false;
         /// The boxes as an AoS slice of [`Aabb3`], when they are one.
         fn aabb3s(&self) -> Option<&[Aabb3]> {
             None
@@ -103,6 +105,8 @@ pub(crate) mod sealed {
         }
         /// Writes box `i`.
         fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
+        /// True when [`WriteBoxes::aabb3s_mut`] always returns the boxes.
+        const AABB3S: bool = false;
         /// The boxes as an AoS slice of [`Aabb3`], when they are one.
         fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
             None
@@ -141,6 +145,8 @@ pub(crate) mod sealed {
         -> <Self::Class as Class<N>>::Lanes<L>;
         /// Transform `i`, for the extended path.
         fn get(&self, i: usize) -> Self::Class;
+        /// True when [`ReadMaps::maps`] always returns the transforms.
+        const MAPS: bool = false;
         /// The transforms as an AoS slice or one shared transform, when they are.
         fn maps(&self) -> Option<Maps<'_, Self::Class>> {
             None
