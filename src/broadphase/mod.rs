@@ -531,6 +531,29 @@ mod tests {
         }
     }
 
+    /// The objects whose fat box an update from empty fat boxes `fat` writes, as bits.
+    fn written<B: BoxSource<3>, P: PoseSource<3>, F>(
+        batch: &Batch,
+        active: Active<'_>,
+        local: B,
+        poses: P,
+        mut fat: F,
+    ) -> u64
+    where
+        for<'f> &'f mut F: BoxSink<3>,
+    {
+        let written = Cell::new(0);
+        let spy = Spy {
+            fat: &mut fat,
+            written: &written,
+        };
+        let margin = Margin::new(0.1, 0.0);
+        batch
+            .update(margin, active, local, poses, spy, &mut Moved::new())
+            .unwrap();
+        written.get()
+    }
+
     #[test]
     fn inactive_objects_are_never_written() {
         // Every active object leaves its (empty) fat box; every other object is inactive,
@@ -561,44 +584,16 @@ mod tests {
                     if deterministic {
                         batch = batch.deterministic();
                     }
-                    let margin = Margin::new(0.1, 0.0);
-                    let mut moved = Moved::new();
-                    let written = Cell::new(0);
                     let what = alloc::format!("{backend:?} {active:?} {deterministic}");
-
-                    let mut fat = alloc::vec![Aabb3::EMPTY; n];
-                    let spy = Spy {
-                        fat: &mut fat[..],
-                        written: &written,
-                    };
-                    batch
-                        .update(margin, active, &local[..], &poses[..], spy, &mut moved)
-                        .unwrap();
                     // The spy hides the AoS slice, so AoS boxes take the lane loop (the AoS
                     // loop, `AosFat`, visits active objects only).
-                    assert_eq!(written.get(), set, "AoS, lane loop {what}");
-
-                    written.set(0);
-                    let mut fat8: alloc::vec::Vec<Aabb3x8> = Block8::pack(&[Aabb3::EMPTY; 40]);
-                    let spy = Spy {
-                        fat: &mut fat8[..],
-                        written: &written,
-                    };
-                    batch
-                        .update(margin, active, &l8[..], &p8[..], spy, &mut moved)
-                        .unwrap();
-                    assert_eq!(written.get(), set, "AoSoA {what}");
-
-                    written.set(0);
-                    let mut fats = Soa::<Aabb3>::from_slice(&[Aabb3::EMPTY; 40]);
-                    let spy = Spy {
-                        fat: &mut fats,
-                        written: &written,
-                    };
-                    batch
-                        .update(margin, active, &ls, &ps, spy, &mut moved)
-                        .unwrap();
-                    assert_eq!(written.get(), set, "SoA {what}");
+                    let fat = alloc::vec![Aabb3::EMPTY; n];
+                    let aos = written(&batch, active, &local[..], &poses[..], fat.clone());
+                    assert_eq!(aos, set, "AoS, lane loop {what}");
+                    let aosoa = written(&batch, active, &l8[..], &p8[..], Block8::pack(&fat));
+                    assert_eq!(aosoa, set, "AoSoA {what}");
+                    let soa = written(&batch, active, &ls, &ps, Soa::from_slice(&fat));
+                    assert_eq!(soa, set, "SoA {what}");
                 }
             }
         }
