@@ -99,28 +99,13 @@ impl Lane for Vec3A {
     }
     #[inline(always)]
     fn mul_add(self, b: Self, c: Self) -> Self {
-        // glam's `Vec3A::mul_add` calls `fmaf` per component when FMA is not enabled at
-        // compile time; fuse only where the instruction is known to exist.
-        if cfg!(target_feature = "fma") {
-            Vec3A::mul_add(self, b, c)
-        } else {
-            self * b + c
-        }
+        // Never fused, whatever the build's target features: the single-box kernel and the
+        // AoS loop give the scalar reference's bits, which deterministic mode promises.
+        self * b + c
     }
     #[inline(always)]
     fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self {
         Vec3A::select(self.cmpge(Vec3A::ZERO), if_nonneg, otherwise)
-    }
-    /// The smaller and larger of the two products: on SSE2 a select is three operations
-    /// and there is no blend, so `min`/`max` of `self·lo` and `self·hi` (the same rounded
-    /// products, rounding being monotone) is cheaper; never fused. A NaN product cannot
-    /// hide a bad map: a NaN entry makes both products NaN and an infinite one the other
-    /// product infinite; a NaN box can give finite faces here, and fails the caller's
-    /// `min <= max` test instead.
-    #[inline(always)]
-    fn add_signed_products(self, lo: Self, hi: Self, min: Self, max: Self) -> (Self, Self) {
-        let (p, q) = (self * lo, self * hi);
-        (min + p.min(q), max + p.max(q))
     }
 }
 

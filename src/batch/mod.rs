@@ -3,11 +3,15 @@
 #[cfg(feature = "rayon")]
 mod parallel;
 
-use crate::engine::{Active, All, AosRun, Engine, Poses, Store};
+use core::marker::PhantomData;
+
+use crate::aabb::Aabb3;
+use crate::engine::{Active, All, AosPoses, AosRun, ClassJob, Engine, Poses, Store, takes_aos};
 use crate::error::BatchError;
-use crate::layout::{BoxSink, BoxSource, ReadBoxes, ReadMaps, TransformSource, WriteBoxes};
+use crate::layout::{BoxSink, BoxSource, Maps, ReadBoxes, ReadMaps, TransformSource, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
+use crate::transform::Transform3;
 
 /// How a batch runs: the method, the rounding and the backend.
 ///
@@ -72,12 +76,11 @@ impl Batch {
     }
 
     /// The same batch in deterministic mode, for lockstep networking and replays: no
-    /// multiply-add is fused, and the AoS path runs in lanes like every other layout, so
-    /// that every backend, every layout and the scalar reference give the same bits
-    /// (on any x86-64 CPU, for the same build). It costs the fused backends a few percent
-    /// in cache; the default stays the fastest. Without the `std` feature the batch kernels
-    /// never fuse (`core` has no fused multiply-add), so the lane backends already give
-    /// these bits; only the AoS path still differs until this mode is chosen.
+    /// multiply-add is fused, so that every backend, every layout and the scalar reference
+    /// give the same bits (on any x86-64 CPU, for the same build). It costs the fused
+    /// backends a few percent in cache; the default stays the fastest. The AoS 3D path (and
+    /// [`Aabb3::transformed`]) never fuses, so it gives these bits in both modes; so do the
+    /// lanes without the `std` feature (`core` has no fused multiply-add).
     #[must_use]
     pub fn deterministic(self) -> Self {
         Self {
@@ -124,20 +127,42 @@ impl Batch {
         mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
         let len = checked_len(&local, &xf, &mut out)?;
-        if let (false, Some(boxes), Some(sink)) =
-            (self.deterministic, local.aabb3s(), out.aabb3s_mut())
-        {
-            let run = AosRun {
-                local: boxes,
-                sink,
-                active: All,
-                method: self.method,
-                rounding: self.rounding,
+        self.transform_checked(local, xf, out, len);
+        Ok(())
+    }
+
+    /// [`Batch::transform`], its lengths checked: the layouts pick the loop when the call
+    /// site is compiled, so that AoS 3D layouts compile no lane loop there and call code
+    /// compiled once in bvkit.
+    #[inline(always)]
+    fn transform_checked<const N: usize, B: BoxSource<N>, X: TransformSource<N>, O: BoxSink<N>>(
+        &self,
+        local: B,
+        xf: X,
+        mut out: O,
+        len: usize,
+    ) {
+        if AosLayouts::<N, B, X, O>::ALL {
+            let (Some(local), Some(poses), Some(out)) =
+                (local.aabb3s(), xf.aos(), out.aabb3s_mut())
+            else {
+                unreachable!("AoS 3D layouts always convert (a test checks every layout)");
             };
-            if xf.run_aos(run, self.backend) {
-                return Ok(());
-            }
+            self.transform_aos(local, poses, out);
+        } else {
+            self.transform_lanes(local, xf, out, len);
         }
+    }
+
+    /// [`Batch::transform`] in the lane loop, its lengths checked.
+    #[inline(always)]
+    fn transform_lanes<const N: usize>(
+        &self,
+        local: impl BoxSource<N>,
+        xf: impl TransformSource<N>,
+        out: impl BoxSink<N>,
+        len: usize,
+    ) {
         let engine = Engine {
             local,
             poses: xf,
@@ -151,11 +176,55 @@ impl Batch {
             rounding: self.rounding,
         };
         engine.run_every(self.backend, !self.deterministic);
-        Ok(())
+    }
+
+    /// [`Batch::transform`] of AoS 3D boxes with AoS or shared poses, lengths checked:
+    /// compiled here once per class, for every call site.
+    #[inline(never)]
+    fn transform_aos(&self, local: &[Aabb3], poses: AosPoses<'_>, out: &mut [Aabb3]) {
+        /// The transform of one class.
+        struct Job<'b, 'o> {
+            batch: &'b Batch,
+            local: &'b [Aabb3],
+            out: &'o mut [Aabb3],
+        }
+        impl<'a> ClassJob<'a> for Job<'_, '_> {
+            fn run<T: Transform3>(self, maps: Maps<'a, T>) {
+                let Job { batch, local, out } = self;
+                if takes_aos(batch.backend) {
+                    let run = AosRun {
+                        local,
+                        sink: out,
+                        active: All,
+                        method: batch.method,
+                        rounding: batch.rounding,
+                    };
+                    return run.run(maps);
+                }
+                let len = local.len();
+                match maps {
+                    Maps::Each(poses) => batch.transform_lanes(local, poses, out, len),
+                    Maps::Shared(pose) => batch.transform_lanes(local, pose, out, len),
+                }
+            }
+        }
+        poses.run(Job {
+            batch: self,
+            local,
+            out,
+        });
     }
 }
 
-/// The common length of a batch, checked before anything is written.
+/// Three layouts as types: boxes `B` in, poses `X`, boxes `O` out.
+pub(crate) struct AosLayouts<const N: usize, B, X, O>(PhantomData<(B, X, O)>);
+
+impl<const N: usize, B: ReadBoxes<N>, X: Poses<N>, O: WriteBoxes<N>> AosLayouts<N, B, X, O> {
+    /// True when they are AoS 3D boxes in and out and AoS or shared poses (of a 3D class,
+    /// then): a constant, so that the branch not taken is not compiled.
+    pub const ALL: bool = B::AABB3S && X::AOS && O::AABB3S;
+}
+
 fn checked_len<const N: usize>(
     local: &impl ReadBoxes<N>,
     xf: &impl ReadMaps<N>,
@@ -181,7 +250,7 @@ mod tests {
     use crate::aabb::Aabb3;
     use crate::layout::{Aabb3x8, Block8};
     use crate::simd::{F32s, LaneArray};
-    use crate::transform::{Rigid3, Trs3};
+    use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
 
@@ -237,6 +306,29 @@ mod tests {
             && a.iter()
                 .zip(b)
                 .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
+    }
+
+    /// Layouts whose types say they are AoS 3D boxes with AoS or shared poses.
+    fn aos<B: ReadBoxes<3>, X: Poses<3>, O: WriteBoxes<3>>(local: B, xf: X, mut out: O) {
+        assert!(AosLayouts::<3, B, X, O>::ALL);
+        assert!(local.aabb3s().is_some() && xf.aos().is_some() && out.aabb3s_mut().is_some());
+    }
+
+    /// Every layout whose constants send a call to the AoS runs converts to them: the
+    /// `unreachable!` of [`Batch::transform`] and [`Batch::update`] is never reached.
+    #[test]
+    fn aos_layouts_always_convert() {
+        let local = vec![Aabb3::EMPTY; 3];
+        let mut out = vec![Aabb3::NAN; 3];
+        let (rigid, affine) = (vec![Rigid3::IDENTITY; 3], vec![Affine3A::IDENTITY; 3]);
+        aos(&local[..], &rigid[..], &mut out[..]);
+        aos(&local, &rigid, &mut out);
+        aos(&local[..], &rigid[0], &mut out[..]);
+        aos(&local, &affine, &mut out);
+        aos(&local, &Trs3::IDENTITY, &mut out);
+        aos(&local, &[Similarity3::IDENTITY; 3][..], &mut out);
+        aos(&local, &[Translation3::IDENTITY; 3][..], &mut out);
+        const { assert!(!AosLayouts::<3, &[Block8<Aabb3>], &[Rigid3], &mut [Aabb3]>::ALL) };
     }
 
     #[test]

@@ -42,6 +42,8 @@ impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         self.src.get(self.start + i)
     }
+    // A window lies inside its source: the range below is always in bounds.
+    const AABB3S: bool = S::AABB3S;
     fn aabb3s(&self) -> Option<&[Aabb3]> {
         self.src.aabb3s()?.get(self.start..self.start + self.len)
     }
@@ -69,6 +71,7 @@ impl<const N: usize, S: ReadMaps<N>> ReadMaps<N> for Window<'_, S> {
     fn get(&self, i: usize) -> S::Class {
         self.src.get(self.start + i)
     }
+    const MAPS: bool = S::MAPS;
     fn maps(&self) -> Option<Maps<'_, S::Class>> {
         match self.src.maps()? {
             Maps::Each(items) => items.get(self.start..self.start + self.len).map(Maps::Each),

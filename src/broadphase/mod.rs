@@ -5,11 +5,14 @@ mod large;
 mod moved;
 
 use crate::aabb::Aabb3;
-use crate::batch::Batch;
-use crate::engine::{Active, AosRun, AosSink, Engine, Poses, Redo, Sink, Tight};
+use crate::batch::{AosLayouts, Batch};
+use crate::engine::{
+    Active, AosPoses, AosRun, AosSink, ClassJob, Engine, Poses, Redo, Sink, Tight, takes_aos,
+};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::lane::Vector;
+use crate::layout::Maps;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, LaneArray};
@@ -254,35 +257,110 @@ impl Batch {
         }
         active.check(len)?;
         moved.reset(len);
-        if let (false, Some(boxes), Some(fat)) =
-            (self.is_deterministic(), local.aabb3s(), fat.aabb3s_mut())
-        {
-            let run = AosRun {
-                local: boxes,
-                sink: AosFat {
-                    fat,
-                    margin,
-                    moved: &mut *moved,
-                },
-                active,
-                method: self.method,
-                rounding: self.rounding,
+        self.update_checked(active, local, poses, Fat { fat, margin, moved }, len);
+        Ok(())
+    }
+
+    /// [`Batch::update`], its inputs checked: the layouts pick the loop when the call site
+    /// is compiled, so that AoS 3D layouts compile no lane loop there and call code
+    /// compiled once in bvkit.
+    #[inline(always)]
+    fn update_checked<const N: usize, B: BoxSource<N>, P: PoseSource<N>, F: BoxSink<N>>(
+        &self,
+        active: Active<'_>,
+        local: B,
+        poses: P,
+        sink: Fat<'_, F>,
+        len: usize,
+    ) {
+        if AosLayouts::<N, B, P, F>::ALL {
+            let Fat {
+                mut fat,
+                margin,
+                moved,
+            } = sink;
+            let (Some(local), Some(poses), Some(fat)) =
+                (local.aabb3s(), poses.aos(), fat.aabb3s_mut())
+            else {
+                unreachable!("AoS 3D layouts always convert (a test checks every layout)");
             };
-            if poses.run_aos(run, self.backend()) {
-                return Ok(());
-            }
+            self.update_aos(active, local, poses, AosFat { fat, margin, moved });
+        } else {
+            self.update_lanes(active, local, poses, sink, len);
         }
+    }
+
+    /// [`Batch::update`] in the lane loop, its inputs checked.
+    #[inline(always)]
+    fn update_lanes<const N: usize, F: WriteBoxes<N>>(
+        &self,
+        active: Active<'_>,
+        local: impl BoxSource<N>,
+        poses: impl PoseSource<N>,
+        sink: Fat<'_, F>,
+        len: usize,
+    ) {
         let engine = Engine {
             local,
             poses,
-            sink: Fat { fat, margin, moved },
+            sink,
             len,
             active,
             method: self.method,
             rounding: self.rounding,
         };
         engine.run(self.backend(), !self.is_deterministic());
-        Ok(())
+    }
+
+    /// [`Batch::update`] of AoS 3D boxes with AoS or shared poses, its inputs checked:
+    /// compiled here once per class, for every call site.
+    #[inline(never)]
+    fn update_aos(
+        &self,
+        active: Active<'_>,
+        local: &[Aabb3],
+        poses: AosPoses<'_>,
+        sink: AosFat<'_>,
+    ) {
+        /// The update of one class.
+        struct Job<'b, 'f> {
+            batch: &'b Batch,
+            active: Active<'b>,
+            local: &'b [Aabb3],
+            sink: AosFat<'f>,
+        }
+        impl<'a> ClassJob<'a> for Job<'_, '_> {
+            fn run<T: Transform3>(self, maps: Maps<'a, T>) {
+                let Job {
+                    batch,
+                    active,
+                    local,
+                    sink,
+                } = self;
+                if takes_aos(batch.backend()) {
+                    let run = AosRun {
+                        local,
+                        sink,
+                        active,
+                        method: batch.method,
+                        rounding: batch.rounding,
+                    };
+                    return run.run(maps);
+                }
+                let AosFat { fat, margin, moved } = sink;
+                let (len, fat) = (local.len(), Fat { fat, margin, moved });
+                match maps {
+                    Maps::Each(poses) => batch.update_lanes(active, local, poses, fat, len),
+                    Maps::Shared(pose) => batch.update_lanes(active, local, pose, fat, len),
+                }
+            }
+        }
+        poses.run(Job {
+            batch: self,
+            active,
+            local,
+            sink,
+        });
     }
 }
 

@@ -12,7 +12,7 @@ use crate::aabb::Aabb3;
 use crate::layout::Maps;
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend};
-use crate::transform::{Simd3Job, Transform3};
+use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of one step of a mask's walk: a mask word's worth.
 const SPAN: usize = 64;
@@ -131,10 +131,65 @@ pub(crate) struct AosRun<'a, S, A> {
     pub rounding: Rounding,
 }
 
-impl<'a, S, A> AosRun<'a, S, A> {
-    /// The run with its poses, one per object or shared.
-    pub fn with<T>(self, maps: Maps<'a, T>) -> AosOn<'a, T, S, A> {
-        AosOn { run: self, maps }
+impl<S: AosSink, A: AosActive> AosRun<'_, S, A> {
+    /// Runs over the active objects with `maps`, on a backend that [`takes_aos`].
+    #[inline(always)]
+    pub fn run<T: Transform3>(self, maps: Maps<'_, T>) {
+        A::walk(self, maps);
+    }
+}
+
+/// True where the AoS loop runs: every backend but the scalar reference, in both modes (the
+/// single-box kernel never fuses, so it gives the reference's bits).
+#[inline(always)]
+pub(crate) fn takes_aos(backend: Backend) -> bool {
+    backend != Backend::Scalar
+}
+
+/// AoS or shared poses of a 3D class, by name: what a generic call site hands to the AoS
+/// runs that bvkit compiles once per class ([`ClassJob`]).
+#[derive(Clone, Copy)]
+pub(crate) struct AosPoses<'a> {
+    poses: Named3<'a>,
+    shared: bool,
+}
+
+/// A job over the poses of any 3D class, run by [`AosPoses::run`] with the class's type.
+pub(crate) trait ClassJob<'a> {
+    /// Runs the job with poses of class `T`.
+    fn run<T: Transform3>(self, maps: Maps<'a, T>);
+}
+
+impl<'a> AosPoses<'a> {
+    /// The poses by name, where their class is a 3D one.
+    #[inline(always)]
+    pub fn of<const N: usize, T: Class<N>>(maps: Maps<'a, T>) -> Option<Self> {
+        let (poses, shared) = match maps {
+            Maps::Each(poses) => (poses, false),
+            Maps::Shared(pose) => (core::slice::from_ref(pose), true),
+        };
+        Some(AosPoses {
+            poses: T::named(poses)?,
+            shared,
+        })
+    }
+
+    /// Runs `job` with the poses in their class's type.
+    pub fn run(self, job: impl ClassJob<'a>) {
+        fn maps<T>(poses: &[T], shared: bool) -> Maps<'_, T> {
+            match (shared, poses) {
+                (true, [pose]) => Maps::Shared(pose),
+                _ => Maps::Each(poses),
+            }
+        }
+        let shared = self.shared;
+        match self.poses {
+            Named3::Translation3(p) => job.run::<Translation3>(maps(p, shared)),
+            Named3::Rigid3(p) => job.run::<Rigid3>(maps(p, shared)),
+            Named3::Similarity3(p) => job.run::<Similarity3>(maps(p, shared)),
+            Named3::Trs3(p) => job.run::<Trs3>(maps(p, shared)),
+            Named3::Affine3A(p) => job.run::<glam::Affine3A>(maps(p, shared)),
+        }
     }
 }
 
@@ -180,25 +235,6 @@ impl AosActive for Active<'_> {
             Active::Indices(ix) => each_kernel!(run, maps, list, ix),
             Active::Mask(words) => each_kernel!(run, maps, mask, words),
         }
-    }
-}
-
-/// An [`AosRun`] with its poses, as a job for the class's single-box kernel.
-pub(crate) struct AosOn<'a, T, S, A> {
-    run: AosRun<'a, S, A>,
-    maps: Maps<'a, T>,
-}
-
-impl<T, S: AosSink, A: AosActive> Simd3Job<T> for AosOn<'_, T, S, A> {
-    fn run(self, backend: Backend) -> bool
-    where
-        T: Transform3,
-    {
-        if let Backend::Scalar | Backend::Wide = backend {
-            return false;
-        }
-        A::walk(self.run, self.maps);
-        true
     }
 }
 

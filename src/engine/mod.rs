@@ -7,7 +7,9 @@
 //! - [`Engine`], in lanes, for every layout; lanes whose result does not stand are redone
 //!   one at a time on the extended path, and the sink takes those too;
 //! - [`AosRun`], for AoS 3D boxes with AoS or shared poses, on the single-box kernel
-//!   (glam's `Vec3A`), which [`Poses::run_aos`] runs where it applies.
+//!   (glam's `Vec3A`), on the backends that [`takes_aos`]. The batch transform and the
+//!   update hand those layouts to code compiled here once per class ([`AosPoses`]), which
+//!   runs this loop or the lane loop.
 
 /// `$body` once per method (and per rounding), with `$m` (and `$r`) bound to it as a
 /// constant, so that each copy is specialised to its kernel: the one place the
@@ -47,7 +49,7 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{All, AosActive, AosRun, AosSink, Tight};
+pub(crate) use aos::{All, AosPoses, AosRun, AosSink, ClassJob, Tight, takes_aos};
 
 use active::{List, Mask, Subset};
 
@@ -91,14 +93,13 @@ pub(crate) trait Poses<const N: usize> {
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
-    /// True when [`Poses::run_aos`] runs every job on the SIMD backends other than `wide`
-    /// (AoS or shared transforms of a 3D class).
+    /// True when [`Poses::aos`] always returns the poses, given 3D boxes (AoS or shared
+    /// transforms).
     const AOS: bool = false;
-    /// Runs `run` (AoS 3D boxes) on the single-box kernel and returns true, or returns
-    /// false where these poses or the backend have none.
-    fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
-        let _ = (run, backend);
-        false
+    /// The poses by name, for the AoS runs, where they are AoS or shared transforms of a 3D
+    /// class.
+    fn aos(&self) -> Option<AosPoses<'_>> {
+        None
     }
     /// The same poses, as the loop reads them.
     type Trimmed: Poses<N> + Clone;
@@ -147,11 +148,9 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
         ReadMaps::trim(self, len)
     }
     const AOS: bool = X::MAPS;
-    fn run_aos<S: AosSink, A: AosActive>(&self, run: AosRun<'_, S, A>, backend: Backend) -> bool {
-        match self.maps() {
-            Some(maps) => X::Class::run_simd3(run.with(maps), backend),
-            None => false,
-        }
+    #[inline(always)]
+    fn aos(&self) -> Option<AosPoses<'_>> {
+        AosPoses::of(self.maps()?)
     }
 }
 
@@ -330,18 +329,18 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
         }
     }
 
-    /// True when every run of these types that a SIMD backend other than `wide` takes fused
-    /// goes to the AoS loop first (AoS 3D boxes in and out, AoS or shared poses: the batch
-    /// transform and the update try [`Poses::run_aos`] whenever the lanes may fuse), so that
-    /// the lanes never run fused AVX2 or AVX-512 code.
+    /// True for AoS 3D boxes in and out with AoS or shared poses, which the lane loop runs
+    /// only on the scalar backend ([`takes_aos`]).
     const AOS: bool = B::AABB3S && P::AOS && S::AABB3S;
 
-    /// [`simd::dispatch`], without the fused AVX2 and AVX-512 lanes where [`Self::AOS`]:
-    /// they were a fifth of the code of an AoS call site.
+    /// [`simd::dispatch`], or straight to the scalar reference's lanes where [`Self::AOS`]:
+    /// the one backend those layouts take the lane loop on. These runs are compiled once in
+    /// bvkit for every class, beside the AoS loop.
     #[inline(always)]
     fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
         if Self::AOS {
-            simd::dispatch_in::<J, false>(backend, fused, job);
+            debug_assert_eq!(backend, Backend::Scalar);
+            job.run::<f32>();
         } else {
             simd::dispatch(backend, fused, job);
         }

@@ -153,17 +153,8 @@ pub(crate) trait Job {
 /// AVX2 and AVX-512 lanes fuse multiply-adds (with the `std` feature only). Unfused, every
 /// backend does the same arithmetic as the scalar reference (`wide` then runs the baseline
 /// lanes, since its fusing is fixed at compile time).
-#[inline(always)]
-pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
-    dispatch_in::<J, true>(backend, fused, job);
-}
-
-/// [`dispatch`], compiling the fused AVX2 and AVX-512 wrappers only where `FUSED_SIMD`:
-/// without it, a fused request for those backends runs unfused, under the same contract. For
-/// the jobs whose fused runs on those backends never happen (the engine's, where AoS 3D
-/// boxes go to the single-box kernel instead), so that a call site does not compile them.
 #[allow(unsafe_code)] // the one place: calling the `#[target_feature]` wrappers
-pub(crate) fn dispatch_in<J: Job, const FUSED_SIMD: bool>(backend: Backend, fused: bool, job: J) {
+pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     debug_assert!(backend.is_supported());
     // Without `std` the fused lanes would call libm's software `fmaf`: `core` has no fused
     // multiply-add to compile to. Every backend then runs unfused, as in deterministic mode.
@@ -175,17 +166,17 @@ pub(crate) fn dispatch_in<J: Job, const FUSED_SIMD: bool>(backend: Backend, fuse
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has every
         // feature of `Backend::Avx2.features()`, the set `run_avx2` enables.
-        (Backend::Avx2, true) if FUSED_SIMD => unsafe { run_avx2::<J, Avx8<true>>(job) },
+        (Backend::Avx2, true) => unsafe { run_avx2::<J, Avx8<true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        (Backend::Avx2, _) => unsafe { run_avx2::<J, Avx8<false>>(job) },
+        (Backend::Avx2, false) => unsafe { run_avx2::<J, Avx8<false>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has every
         // feature of `Backend::Avx512.features()`, the set `run_avx512` enables.
-        (Backend::Avx512, true) if FUSED_SIMD => unsafe { run_avx512::<J, F32s<16, true>>(job) },
+        (Backend::Avx512, true) => unsafe { run_avx512::<J, F32s<16, true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        (Backend::Avx512, _) => unsafe { run_avx512::<J, F32s<16, false>>(job) },
+        (Backend::Avx512, false) => unsafe { run_avx512::<J, F32s<16, false>>(job) },
         #[cfg(not(target_arch = "x86_64"))]
         (Backend::Avx2 | Backend::Avx512, _) => job.run::<F32s<8, false>>(),
     }

@@ -2,13 +2,12 @@
 
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
-use super::{Class, Simd3, Simd3Job, Transform2, Transform3};
+use super::{Class, Named3, Simd3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::AffineLanes;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;
-use crate::simd::Backend;
 
 /// Fields `[m00, m10, m20, m01, …, m22, t0, t1, t2]`: the columns, then the translation.
 impl Fields for Affine3A {
@@ -36,8 +35,8 @@ impl Fields for Affine3A {
 }
 
 impl Class<3> for Affine3A {
-    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-        job.run(backend)
+    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+        Some(Named3::Affine3A(poses))
     }
     type Lanes<L: Lane> = AffineLanes<Vector<L, 3>, 3>;
     #[inline(always)]

@@ -14,7 +14,7 @@ pub use translation::{Translation2, Translation3};
 
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Simd3, Simd3Job};
+pub(crate) use sealed::{Class, Named3, Simd3};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -93,17 +93,22 @@ pub(crate) mod sealed {
     use crate::fields::{Fields, MAX_FIELDS};
     use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
-    use crate::simd::Backend;
 
-    /// A job over AoS 3D boxes that runs the single-box kernel of its class `T`, which the
-    /// generic batch code knows only as a [`Class`](crate::transform::Class): the class's
-    /// `run_simd3` hook runs it where `T` is a [`Transform3`].
-    pub trait Simd3Job<T> {
-        /// Runs the job and returns true, or returns false where `backend` keeps its own
-        /// lanes (the scalar reference and `wide`).
-        fn run(self, backend: Backend) -> bool
-        where
-            T: Transform3;
+    /// Poses of a 3D class by name: how generic code reaches the code bvkit compiles once
+    /// per class (the AoS runs), so that a caller's crate compiles a call rather than the
+    /// loops.
+    #[derive(Clone, Copy)]
+    pub enum Named3<'a> {
+        /// [`Translation3`] poses.
+        Translation3(&'a [Translation3]),
+        /// [`Rigid3`] poses.
+        Rigid3(&'a [Rigid3]),
+        /// [`Similarity3`] poses.
+        Similarity3(&'a [Similarity3]),
+        /// [`Trs3`] poses.
+        Trs3(&'a [Trs3]),
+        /// `Affine3A` poses.
+        Affine3A(&'a [glam::Affine3A]),
     }
 
     /// A transform class in `N` dimensions.
@@ -116,12 +121,13 @@ pub(crate) mod sealed {
         fn extended(&self) -> ExtendedMap<N>;
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
-        /// Runs a job on the single-box kernel (a 3D AoS batch or update) and returns
-        /// true, or returns false where the class or the backend has none (2D classes,
-        /// the scalar and `wide` backends).
-        fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-            let _ = (job, backend);
-            false
+        /// The poses by name: every 3D class, none of the 2D ones.
+        fn named(poses: &[Self]) -> Option<Named3<'_>>
+        where
+            Self: Sized,
+        {
+            let _ = poses;
+            None
         }
     }
 

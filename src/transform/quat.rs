@@ -7,14 +7,13 @@
 
 use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
-use super::{Class, Simd3, Simd3Job, Transform3};
+use super::{Class, Named3, Simd3, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
-use crate::simd::Backend;
 
 /// A rotation then a translation: `x ↦ R(q)·x + t`.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -333,8 +332,8 @@ impl Fields for Trs3 {
 }
 
 impl Class<3> for Rigid3 {
-    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-        job.run(backend)
+    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+        Some(Named3::Rigid3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
     #[inline(always)]
@@ -350,8 +349,8 @@ impl Class<3> for Rigid3 {
 }
 
 impl Class<3> for Similarity3 {
-    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-        job.run(backend)
+    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+        Some(Named3::Similarity3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
@@ -368,8 +367,8 @@ impl Class<3> for Similarity3 {
 }
 
 impl Class<3> for Trs3 {
-    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-        job.run(backend)
+    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+        Some(Named3::Trs3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]

@@ -2,14 +2,13 @@
 
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
-use super::{Class, Simd3, Simd3Job, Transform2, Transform3};
+use super::{Class, Named3, Simd3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
 use crate::kernel::MapKernel;
 use crate::lane::{Lane, Vector};
 use crate::method::Method;
-use crate::simd::Backend;
 
 /// A 3D translation `x ↦ x + t`.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -120,8 +119,8 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
-    fn run_simd3<J: Simd3Job<Self>>(job: J, backend: Backend) -> bool {
-        job.run(backend)
+    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+        Some(Named3::Translation3(poses))
     }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
     #[inline(always)]
