@@ -105,9 +105,9 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
 /// Sign-select: face `i` of the minimum is `t_i + sum_j m_ij * (m_ij >= 0 ? lo_j : hi_j)`,
 /// and the maximum takes the other face. No center/extent round trip.
 ///
-/// Each step is [`Lane::add_signed_products`]: a sign test and two multiply-adds in the
-/// batch lanes, the smaller and larger of the two products on SSE2's `Vec3A`, which has
-/// no blend (rounding is monotone, so both choose the same rounded product).
+/// Each step is [`Lane::add_signed_products`]: unfused, the smaller and the larger of the
+/// two products, the same operations in every lane type (so the single-box kernel gives
+/// the scalar reference's bits); fused, a sign test, two selects and two multiply-adds.
 ///
 /// Error: `N` products and `N` additions per face, `γ(N+1)·S + TINY_ERROR`.
 #[inline(always)]

@@ -17,6 +17,8 @@ use glam::Vec3A;
 pub trait Lane:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
 {
+    /// True when [`Lane::mul_add`] rounds once.
+    const FUSES: bool = false;
     /// Every lane set to `x`.
     fn splat(x: f32) -> Self;
     /// Lane-wise minimum as `minps` computes it: `self < other ? self : other`, so equal
@@ -32,13 +34,28 @@ pub trait Lane:
     fn select_nonneg(self, if_nonneg: Self, otherwise: Self) -> Self;
 
     /// One sign-select step: `self·(self >= 0 ? lo : hi)` added to `min` and
-    /// `self·(self >= 0 ? hi : lo)` added to `max`, each with [`Lane::mul_add`].
+    /// `self·(self >= 0 ? hi : lo)` added to `max` (for `lo <= hi`).
+    ///
+    /// Unfused, the smaller and the larger of the rounded products `self·lo` and `self·hi`
+    /// (rounding is monotone, so they are the products the sign selects, up to the sign of
+    /// a zero): two operations in place of a compare and two selects, and SSE2 has no
+    /// blend. Every unfused lane type computes this, so all give the same bits. A NaN
+    /// product cannot hide a bad map: a NaN entry makes both products NaN, an infinite one
+    /// the other product infinite or NaN, and a non-finite face fails the caller's check;
+    /// a NaN box fails its own check whatever the faces. Where the lane type
+    /// [fuses](Lane::FUSES), the factor is selected by the sign and each face is one fused
+    /// multiply-add instead.
     #[inline(always)]
     fn add_signed_products(self, lo: Self, hi: Self, min: Self, max: Self) -> (Self, Self) {
-        (
-            self.mul_add(self.select_nonneg(lo, hi), min),
-            self.mul_add(self.select_nonneg(hi, lo), max),
-        )
+        if Self::FUSES {
+            (
+                self.mul_add(self.select_nonneg(lo, hi), min),
+                self.mul_add(self.select_nonneg(hi, lo), max),
+            )
+        } else {
+            let (p, q) = (self * lo, self * hi);
+            (min + p.min(q), max + p.max(q))
+        }
     }
 }
 
@@ -179,6 +196,7 @@ impl<L: Lane, const N: usize> Neg for Vector<L, N> {
 }
 
 impl<L: Lane, const N: usize> Lane for Vector<L, N> {
+    const FUSES: bool = L::FUSES;
     #[inline(always)]
     fn splat(x: f32) -> Self {
         Vector([L::splat(x); N])

@@ -149,6 +149,7 @@ impl<const W: usize, const FMA: bool> Neg for F32s<W, FMA> {
 }
 
 impl<const W: usize, const FMA: bool> Lane for F32s<W, FMA> {
+    const FUSES: bool = FMA;
     #[inline(always)]
     fn splat(x: f32) -> Self {
         F32s([x; W])
@@ -258,6 +259,8 @@ impl<const W: usize, const FMA: bool> LaneArray for F32s<W, FMA> {
 }
 
 impl Lane for wide::f32x8 {
+    // `wide` fuses exactly when FMA is enabled at compile time.
+    const FUSES: bool = cfg!(target_feature = "fma");
     #[inline(always)]
     fn splat(x: f32) -> Self {
         wide::f32x8::splat(x)
@@ -419,6 +422,7 @@ mod avx {
     }
 
     impl<const FMA: bool> Lane for Avx8<FMA> {
+        const FUSES: bool = FMA;
         #[inline(always)]
         fn splat(x: f32) -> Self {
             Avx8(avx!(_mm256_set1_ps(x)))
