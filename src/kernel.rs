@@ -8,6 +8,8 @@
 
 use core::ops::{Add, Mul, Sub};
 
+use glam::Vec3A;
+
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::{Method, REACH_FLOOR, UNIT_ROUNDOFF};
 
@@ -16,6 +18,30 @@ pub trait MapKernel<V> {
     /// The fast-path kernel: pure round-to-nearest arithmetic, padded outward when
     /// asked; its callers check that the box is non-empty and the result finite.
     fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V);
+}
+
+/// A map on `Vec3A` lanes (one box) that two of can share wider lanes `P`, each in its own
+/// half: the AoS loop's two boxes per instruction.
+pub trait JoinLanes: MapKernel<Vec3A> {
+    /// The same map in lanes `P`.
+    type In<P: Axes>: MapKernel<P>;
+    /// `a` and `b` side by side: every field `join(a's, b's)`.
+    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> Self::In<P>;
+}
+
+impl JoinLanes for AffineLanes<Vec3A, 3> {
+    type In<P: Axes> = AffineLanes<P, 3>;
+    #[inline(always)]
+    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> AffineLanes<P, 3> {
+        AffineLanes {
+            cols: [
+                join(a.cols[0], b.cols[0]),
+                join(a.cols[1], b.cols[1]),
+                join(a.cols[2], b.cols[2]),
+            ],
+            t: join(a.t, b.t),
+        }
+    }
 }
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.

@@ -846,3 +846,142 @@ fn streamed_outputs_have_the_same_bits() {
         assert!(bits(&streamed) == bits(&stored), "{backend:?}");
     }
 }
+
+/// Boxes as the AoS loop meets them: ordinary ones, with one in about 97 that the fast
+/// kernels cannot answer (NaN, empty, unbounded, overflowing) at a random position.
+fn sparse_bad_boxes(len: usize, r: &mut StdRng) -> Vec<Aabb3> {
+    let big = f32::MAX * 0.75;
+    let bad = [
+        Aabb3::new(Vec3A::new(f32::NAN, -1.0, 0.0), Vec3A::ONE),
+        Aabb3::EMPTY,
+        Aabb3::new(Vec3A::new(-1.0, f32::NEG_INFINITY, 0.0), Vec3A::ONE),
+        Aabb3::new(Vec3A::splat(-big), Vec3A::splat(big)),
+        Aabb3::new(Vec3A::ONE, Vec3A::new(1.0, 0.5, 1.0)),
+    ];
+    (0..len)
+        .map(|_| {
+            if r.random_range(0..97) == 0 {
+                return bad[r.random_range(0..bad.len())];
+            }
+            let c = Vec3A::new(r.random(), r.random(), r.random()) * 200.0 - 100.0;
+            let e = Vec3A::new(r.random(), r.random(), r.random()) * 5.0;
+            Aabb3::new(c - e, c + e)
+        })
+        .collect()
+}
+
+/// The bits of a box, `x`, `y` and `z` of each face (NaN payloads included).
+fn box_bits(b: &Aabb3) -> [[u32; 3]; 2] {
+    [b.min.to_array(), b.max.to_array()].map(|v| v.map(f32::to_bits))
+}
+
+/// The AoS loop runs two boxes per vector and the single-box kernel's test once per chunk of
+/// 64, redoing a failed chunk one box at a time. Whatever the backend, the mode, the
+/// method, the rounding, the pose kind, the length (odd tails, chunk edges) and wherever
+/// the bad boxes fall, every box gets the bits of `Aabb3::transformed` on it, and an update
+/// the fat boxes and moved set of the scalar backend.
+fn aos_like_single_box<T: Transform3 + Copy + core::fmt::Debug>(
+    name: &str,
+    pose: impl Fn(&mut StdRng) -> T,
+) {
+    let r = &mut rng(0xa05);
+    for len in [0, 1, 2, 3, 63, 64, 65, 127, 128, 129, 300, 1031] {
+        let local = sparse_bad_boxes(len, r);
+        let poses: Vec<T> = (0..len.max(1)).map(|_| pose(r)).collect();
+        let poses = &poses[..len];
+        let shared = pose(r);
+        let words: Vec<u64> = (0..len.div_ceil(64)).map(|_| r.random()).collect();
+        let words: Vec<u64> = words
+            .iter()
+            .enumerate()
+            .map(|(w, &m)| {
+                if 64 * (w + 1) <= len {
+                    m
+                } else {
+                    m & ((1 << (len % 64)) - 1)
+                }
+            })
+            .collect();
+        let list: Vec<u32> = (0..len as u32).filter(|_| r.random_bool(0.3)).collect();
+        for method in Method::ALL {
+            for rounding in Rounding::ALL {
+                let single: Vec<Aabb3> = local
+                    .iter()
+                    .zip(poses)
+                    .map(|(b, x)| b.transformed(x, method, rounding))
+                    .collect();
+                let single_shared: Vec<Aabb3> = local
+                    .iter()
+                    .map(|b| b.transformed(&shared, method, rounding))
+                    .collect();
+                let scalar = Batch::new(method, rounding).on(Backend::Scalar).unwrap();
+                for backend in Backend::supported() {
+                    for deterministic in [false, true] {
+                        let mut batch = Batch::new(method, rounding).on(backend).unwrap();
+                        if deterministic {
+                            batch = batch.deterministic();
+                        }
+                        let what = format!(
+                            "{name} {backend:?} {deterministic} {method:?} {rounding:?} len {len}"
+                        );
+                        let mut out = vec![Aabb3::NAN; len];
+                        batch.transform(&local, poses, &mut out).unwrap();
+                        for (k, (o, s)) in out.iter().zip(&single).enumerate() {
+                            assert_eq!(box_bits(o), box_bits(s), "{what} box {k}: {:?}", local[k]);
+                        }
+                        batch.transform(&local, &shared, &mut out).unwrap();
+                        for (k, (o, s)) in out.iter().zip(&single_shared).enumerate() {
+                            assert_eq!(box_bits(o), box_bits(s), "{what} shared box {k}");
+                        }
+                        let margin = bvkit::Margin::new(0.5, 0.1);
+                        for active in [
+                            bvkit::Active::All,
+                            bvkit::Active::Indices(&list),
+                            bvkit::Active::Mask(&words),
+                        ] {
+                            let run = |b: &Batch| {
+                                let mut fat = vec![Aabb3::NAN; len];
+                                let mut moved = bvkit::Moved::new();
+                                for _ in 0..2 {
+                                    b.update(margin, active, &local, poses, &mut fat, &mut moved)
+                                        .unwrap();
+                                }
+                                (fat, moved.indices().to_vec())
+                            };
+                            let ((fat, moved), (want_fat, want_moved)) =
+                                (run(&batch), run(&scalar));
+                            assert_eq!(moved, want_moved, "{what} {active:?}");
+                            for (k, (f, w)) in fat.iter().zip(&want_fat).enumerate() {
+                                assert_eq!(box_bits(f), box_bits(w), "{what} {active:?} fat {k}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn aos_batches_give_the_single_box_bits_with_bad_boxes_anywhere() {
+    fn quat(r: &mut StdRng) -> glam::Quat {
+        let v = glam::Vec4::new(r.random(), r.random(), r.random(), r.random()) * 2.0 - 1.0;
+        glam::Quat::from_vec4(v).normalize()
+    }
+    fn t(r: &mut StdRng) -> glam::Vec3 {
+        glam::Vec3::new(r.random(), r.random(), r.random()) * 2000.0 - 1000.0
+    }
+    aos_like_single_box("rigid3", |r| Rigid3::new(quat(r), t(r).into()));
+    aos_like_single_box("affine3", |r| {
+        let s = glam::Vec3::new(r.random(), r.random(), r.random()) * 3.0 - 1.5;
+        Affine3A::from_scale_rotation_translation(s, quat(r), t(r))
+    });
+    aos_like_single_box("trs3", |r| {
+        let s = glam::Vec3::new(r.random(), r.random(), r.random()) * 3.0;
+        Trs3::from((s, quat(r), t(r)))
+    });
+    aos_like_single_box("similarity3", |r| {
+        Similarity3::new(r.random::<f32>() * 4.0, quat(r), t(r).into())
+    });
+    aos_like_single_box("translation3", |r| Translation3(t(r).into()));
+}

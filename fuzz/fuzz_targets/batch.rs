@@ -154,6 +154,13 @@ fn layouts3<T: Transform3, P: Exactly<3>>(
             &format!("aos {what}"),
         );
     }
+    // The AoS loop (two boxes per vector, its test taken per chunk) gives every box the
+    // bits of the single-box call, on every backend and in both modes.
+    let bits = |b: &Aabb3| [b.min.to_array(), b.max.to_array()].map(|v| v.map(f32::to_bits));
+    for ((l, x), o) in local.iter().zip(&xfs).zip(&out) {
+        let single = l.transformed(x, batch.method, batch.rounding);
+        assert_eq!(bits(o), bits(&single), "aos {what}: not the single-box bits of {l:?}");
+    }
     let (lb, xb) = (Block8::pack(&local), Block8::pack(&xfs));
     let mut ob = vec![Block8::<Aabb3>::default(); lb.len()];
     batch.transform(&lb, &xb, &mut ob).unwrap();

@@ -199,7 +199,7 @@ impl Batch {
                         method: batch.method,
                         rounding: batch.rounding,
                     };
-                    return run.run(maps);
+                    return run.run(maps, batch.backend);
                 }
                 let len = local.len();
                 match maps {

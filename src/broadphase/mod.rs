@@ -7,7 +7,8 @@ mod moved;
 use crate::aabb::Aabb3;
 use crate::batch::{AosLayouts, Batch};
 use crate::engine::{
-    Active, AosPoses, AosRun, AosSink, ClassJob, Engine, Poses, Redo, Sink, Tight, takes_aos,
+    Active, AosPoses, AosRun, AosSink, ClassJob, Engine, PoseList, Poses, Redo, Sink, Tight,
+    takes_aos,
 };
 use crate::error::BatchError;
 use crate::fat::Margin;
@@ -15,7 +16,7 @@ use crate::lane::Vector;
 use crate::layout::Maps;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
-use crate::simd::{self, LaneArray};
+use crate::simd::{self, BoxPair, LaneArray};
 use crate::transform::Transform3;
 
 pub use large::{LargePose, LargeRigid3};
@@ -345,7 +346,7 @@ impl Batch {
                         method: batch.method,
                         rounding: batch.rounding,
                     };
-                    return run.run(maps);
+                    return run.run(maps, batch.backend());
                 }
                 let AosFat { fat, margin, moved } = sink;
                 let (len, fat) = (local.len(), Fat { fat, margin, moved });
@@ -515,21 +516,20 @@ impl AosSink for AosFat<'_> {
     /// boxes, then a loop over its set bits. A branch per object would mispredict on every
     /// object a walk moves at random; the loop mispredicts once per eight.
     #[inline(always)]
-    fn run<'p, T: Transform3 + 'p>(
+    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
         &mut self,
         start: usize,
         local: &[Aabb3],
-        mut poses: impl Iterator<Item = &'p T>,
-        tight: Tight,
+        poses: impl PoseList<'p, T>,
+        tight: Tight<P>,
     ) {
         let fat = &mut self.fat[start..start + local.len()];
         for (c, (local, fat)) in local.chunks(8).zip(fat.chunks_mut(8)).enumerate() {
             let mut boxes = [Aabb3::EMPTY; 8];
+            tight.boxes(local, poses, start + 8 * c, &mut boxes[..local.len()]);
             let mut left = 0;
-            let objects = local.iter().zip(&*fat).zip(poses.by_ref());
-            for (k, ((l, f), pose)) in objects.enumerate() {
-                boxes[k] = tight.of(l, pose);
-                left |= u64::from(!crate::fat::inside_aabb3(&boxes[k], f)) << k;
+            for (k, (b, f)) in boxes.iter().zip(&*fat).enumerate() {
+                left |= u64::from(!crate::fat::inside_aabb3(b, f)) << k;
             }
             let mut bits = left;
             while bits != 0 {

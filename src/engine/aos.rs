@@ -11,7 +11,10 @@ use super::active::{List, Mask, Subset, Width};
 use crate::aabb::Aabb3;
 use crate::layout::Maps;
 use crate::method::{Method, Rounding};
-use crate::simd::{self, Backend};
+use core::marker::PhantomData;
+
+use crate::kernel::{JoinLanes, MapKernel};
+use crate::simd::{self, Backend, BoxPair, PairJob};
 use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of one step of a mask's walk: a mask word's worth.
@@ -19,14 +22,14 @@ const SPAN: usize = 64;
 
 /// Where the AoS loop's tight boxes go.
 pub(crate) trait AosSink {
-    /// Objects `start..start + local.len()`, every one active, with their poses in order:
-    /// object `start + k`'s tight box is `tight.of(&local[k], pose)`.
-    fn run<'p, T: Transform3 + 'p>(
+    /// Objects `start..start + local.len()`, every one active: object `start + k`'s tight
+    /// box is `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
+    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
         &mut self,
         start: usize,
         local: &[Aabb3],
-        poses: impl Iterator<Item = &'p T>,
-        tight: Tight,
+        poses: impl PoseList<'p, T>,
+        tight: Tight<P>,
     );
     /// Object `i` alone, with its tight box.
     fn one(&mut self, i: usize, tight: Aabb3);
@@ -37,17 +40,14 @@ pub(crate) trait AosSink {
 /// The plain AoS sink: every tight box written.
 impl AosSink for &mut [Aabb3] {
     #[inline(always)]
-    fn run<'p, T: Transform3 + 'p>(
+    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
         &mut self,
         start: usize,
         local: &[Aabb3],
-        poses: impl Iterator<Item = &'p T>,
-        tight: Tight,
+        poses: impl PoseList<'p, T>,
+        tight: Tight<P>,
     ) {
-        // The slices zipped: no index, so no bounds checks.
-        for ((out, local), pose) in self[start..].iter_mut().zip(local).zip(poses) {
-            *out = tight.of(local, pose);
-        }
+        tight.boxes(local, poses, start, &mut self[start..start + local.len()]);
     }
     #[inline(always)]
     fn one(&mut self, i: usize, tight: Aabb3) {
@@ -59,29 +59,88 @@ impl AosSink for &mut [Aabb3] {
     }
 }
 
-/// The single-box kernel of one method and rounding. A method call rather than a closure:
-/// a closure was compiled out of line, with the method and rounding as run-time values
-/// where each loop has them as constants.
-#[derive(Clone, Copy)]
-pub(crate) struct Tight {
+/// The validity test of the AoS loop is taken once per this many objects.
+const CHUNK: usize = 64;
+
+/// The single-box kernel of one method and rounding, and its pairs `P`. A method call
+/// rather than a closure: a closure was compiled out of line, with the method and rounding
+/// as run-time values where each loop has them as constants.
+pub(crate) struct Tight<P> {
     method: Method,
     rounding: Rounding,
+    pairs: PhantomData<P>,
 }
 
-impl Tight {
+impl<P> Clone for Tight<P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<P> Copy for Tight<P> {}
+
+impl<P: BoxPair> Tight<P> {
     /// The tight world box of `local` at `pose`.
     #[inline(always)]
     pub fn of<T: Transform3>(self, local: &Aabb3, pose: &T) -> Aabb3 {
         local.transformed(pose, self.method, self.rounding)
     }
+
+    /// `out[k] = self.of(&local[k], poses.at(start + k))` for every `k`, two objects per
+    /// vector of `P`. The single-box kernel's own test (`lo <= hi`, finite faces) is
+    /// gathered over each chunk of [`CHUNK`] objects, and a chunk where it fails anywhere is
+    /// redone one object at a time with [`Tight::of`]. Each half of a pair runs the
+    /// operations of the single-box kernel, so every object gets exactly `of`'s bits.
+    #[inline(always)]
+    pub fn boxes<'p, T: Transform3 + 'p>(
+        self,
+        local: &[Aabb3],
+        poses: impl PoseList<'p, T>,
+        start: usize,
+        out: &mut [Aabb3],
+    ) {
+        let outward = self.rounding == Rounding::Outward;
+        for (c, (local, out)) in local.chunks(CHUNK).zip(out.chunks_mut(CHUNK)).enumerate() {
+            let first = start + c * CHUNK;
+            let mut stands = P::all_set();
+            let pairs = local.chunks_exact(2).zip(out.chunks_exact_mut(2));
+            for ((l, o), (a, b)) in pairs.zip(poses.pairs(first)) {
+                let map = <T::Simd as JoinLanes>::join(&a.simd(), &b.simd(), P::join);
+                let (lo, hi) = (P::join(l[0].min, l[1].min), P::join(l[0].max, l[1].max));
+                let (min, max) = map.transform(lo, hi, self.method, outward);
+                stands = P::and(stands, P::stands(lo, hi, min, max));
+                let ((min0, min1), (max0, max1)) = (min.halves(), max.halves());
+                o[0] = Aabb3 {
+                    min: min0,
+                    max: max0,
+                };
+                o[1] = Aabb3 {
+                    min: min1,
+                    max: max1,
+                };
+            }
+            if let (Some(l), Some(o)) = (local.get(local.len() & !1), out.last_mut())
+                && local.len() % 2 == 1
+            {
+                *o = self.of(l, poses.at(first + local.len() - 1));
+            }
+            if !P::all_xyz(stands) {
+                core::hint::cold_path();
+                for ((l, o), pose) in local.iter().zip(out.iter_mut()).zip(poses.from(first)) {
+                    *o = self.of(l, pose);
+                }
+            }
+        }
+    }
 }
 
 /// The poses of the AoS loop, split once from [`Maps`]: a slice, or one shared pose.
-trait PoseList<'p, T: 'p>: Copy {
+pub(crate) trait PoseList<'p, T: 'p>: Copy {
     /// Object `i`'s pose.
     fn at(self, i: usize) -> &'p T;
     /// The poses of objects `start..`, in order.
     fn from(self, start: usize) -> impl Iterator<Item = &'p T>;
+    /// The poses of objects `start..`, two by two.
+    fn pairs(self, start: usize) -> impl Iterator<Item = (&'p T, &'p T)>;
 }
 
 impl<'p, T> PoseList<'p, T> for &'p [T] {
@@ -92,6 +151,10 @@ impl<'p, T> PoseList<'p, T> for &'p [T] {
     #[inline(always)]
     fn from(self, start: usize) -> impl Iterator<Item = &'p T> {
         self[start..].iter()
+    }
+    #[inline(always)]
+    fn pairs(self, start: usize) -> impl Iterator<Item = (&'p T, &'p T)> {
+        self[start..].chunks_exact(2).map(|p| (&p[0], &p[1]))
     }
 }
 
@@ -114,6 +177,10 @@ impl<'p, T> PoseList<'p, T> for Shared<'p, T> {
     fn from(self, _: usize) -> impl Iterator<Item = &'p T> {
         core::iter::repeat(self.0)
     }
+    #[inline(always)]
+    fn pairs(self, _: usize) -> impl Iterator<Item = (&'p T, &'p T)> {
+        core::iter::repeat((self.0, self.0))
+    }
 }
 
 /// A run of the AoS loop, its lengths and its active set checked: everything but the
@@ -134,8 +201,8 @@ pub(crate) struct AosRun<'a, S, A> {
 impl<S: AosSink, A: AosActive> AosRun<'_, S, A> {
     /// Runs over the active objects with `maps`, on a backend that [`takes_aos`].
     #[inline(always)]
-    pub fn run<T: Transform3>(self, maps: Maps<'_, T>) {
-        A::walk(self, maps);
+    pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
+        A::walk(self, maps, backend);
     }
 }
 
@@ -194,12 +261,16 @@ impl<'a> AosPoses<'a> {
 }
 
 /// `$walk(run, poses, tight, $set)` once per method, rounding and pose kind, each
-/// specialised to its kernel.
+/// specialised to its kernel, with pairs `$pairs`.
 macro_rules! each_kernel {
-    ($run:expr, $maps:expr, $walk:ident $(, $set:expr)?) => {{
+    ($run:expr, $maps:expr, $pairs:ty, $walk:ident $(, $set:expr)?) => {{
         let len = $run.local.len();
         specialise!($run.method, $run.rounding, |method, rounding| {
-            let tight = Tight { method, rounding };
+            let tight = Tight::<$pairs> {
+                method,
+                rounding,
+                pairs: PhantomData,
+            };
             match $maps {
                 Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
                 Maps::Shared(pose) => $walk($run, Shared(pose), tight $(, $set)?),
@@ -212,8 +283,12 @@ macro_rules! each_kernel {
 /// can take: [`All`] (a batch transform, the one loop over every object) or an update's
 /// [`Active`] set (that loop, an index list's and a mask's).
 pub(crate) trait AosActive: Copy {
-    /// Runs `run` with `maps` over these objects.
-    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>);
+    /// Runs `run` with `maps` over these objects on `backend`.
+    fn walk<T: Transform3, S: AosSink>(
+        run: AosRun<'_, S, Self>,
+        maps: Maps<'_, T>,
+        backend: Backend,
+    );
 }
 
 /// Every object, known when the run is compiled.
@@ -222,41 +297,85 @@ pub(crate) struct All;
 
 impl AosActive for All {
     #[inline(always)]
-    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>) {
-        every(run, maps);
+    fn walk<T: Transform3, S: AosSink>(
+        run: AosRun<'_, S, Self>,
+        maps: Maps<'_, T>,
+        backend: Backend,
+    ) {
+        simd::dispatch_pairs(backend, Every { run, maps });
     }
 }
 
 impl AosActive for Active<'_> {
+    /// Each walk is a job of its own, so that its loop has the dispatch wrapper's registers
+    /// to itself: compiled beside the scattered walks, the loop over every object kept the
+    /// output pointer on the stack.
     #[inline(always)]
-    fn walk<T: Transform3, S: AosSink>(run: AosRun<'_, S, Self>, maps: Maps<'_, T>) {
+    fn walk<T: Transform3, S: AosSink>(
+        run: AosRun<'_, S, Self>,
+        maps: Maps<'_, T>,
+        backend: Backend,
+    ) {
         match run.active {
-            Active::All => every(run, maps),
-            Active::Indices(ix) => each_kernel!(run, maps, list, ix),
-            Active::Mask(words) => each_kernel!(run, maps, mask, words),
+            Active::All => simd::dispatch_pairs(backend, Every { run, maps }),
+            Active::Indices(ix) => simd::dispatch_pairs(backend, Listed { run, maps, ix }),
+            Active::Mask(words) => simd::dispatch_pairs(backend, Masked { run, maps, words }),
         }
     }
 }
 
-/// Every object through [`Aabb3::transformed`], in one run. A function of its own, so
-/// that its loop has the registers to itself: compiled into the job beside the scattered
-/// walks, it kept the output pointer on the stack.
-#[inline(never)]
-fn every<T: Transform3, S: AosSink, A>(run: AosRun<'_, S, A>, maps: Maps<'_, T>) {
-    each_kernel!(run, maps, whole);
+/// Every object: the AoS loop's job for [`All`] and [`Active::All`].
+struct Every<'a, 'm, S, A, T> {
+    run: AosRun<'a, S, A>,
+    maps: Maps<'m, T>,
 }
 
-/// [`every`] with one method, rounding and pose kind.
+impl<S: AosSink, A, T: Transform3> PairJob for Every<'_, '_, S, A, T> {
+    #[inline(always)]
+    fn run<P: BoxPair>(self) {
+        each_kernel!(self.run, self.maps, P, whole);
+    }
+}
+
+/// The objects of an index list.
+struct Listed<'a, 'm, S, T> {
+    run: AosRun<'a, S, Active<'a>>,
+    maps: Maps<'m, T>,
+    ix: &'a [u32],
+}
+
+impl<S: AosSink, T: Transform3> PairJob for Listed<'_, '_, S, T> {
+    #[inline(always)]
+    fn run<P: BoxPair>(self) {
+        each_kernel!(self.run, self.maps, P, list, self.ix);
+    }
+}
+
+/// The objects of a mask.
+struct Masked<'a, 'm, S, T> {
+    run: AosRun<'a, S, Active<'a>>,
+    maps: Maps<'m, T>,
+    words: &'a [u64],
+}
+
+impl<S: AosSink, T: Transform3> PairJob for Masked<'_, '_, S, T> {
+    #[inline(always)]
+    fn run<P: BoxPair>(self) {
+        each_kernel!(self.run, self.maps, P, mask, self.words);
+    }
+}
+
+/// [`Every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, S: AosSink, A>(
+fn whole<'p, T: Transform3 + 'p, S: AosSink, A, P: BoxPair>(
     run: AosRun<'_, S, A>,
     poses: impl PoseList<'p, T>,
-    tight: Tight,
+    tight: Tight<P>,
 ) {
     let AosRun {
         local, mut sink, ..
     } = run;
-    sink.run(0, local, poses.from(0), tight);
+    sink.run(0, local, poses, tight);
 }
 
 /// Asks for object `i`'s local box, pose and output.
@@ -276,10 +395,10 @@ fn request<'p, T: 'p, S: AosSink>(
 /// list cost more than the objects: 1.4x at 1% and 10% active, measured on an Intel
 /// Xeon). Their memory is requested ahead, one object further as each runs.
 #[inline(always)]
-fn list<'p, T: Transform3 + 'p, S: AosSink>(
+fn list<'p, T: Transform3 + 'p, S: AosSink, P: BoxPair>(
     run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
-    tight: Tight,
+    tight: Tight<P>,
     ix: &[u32],
 ) {
     let AosRun {
@@ -303,10 +422,10 @@ fn list<'p, T: Transform3 + 'p, S: AosSink>(
 /// one at a time. The scattered objects' memory is requested ahead, one object further as
 /// each runs.
 #[inline(always)]
-fn mask<'p, T: Transform3 + 'p, S: AosSink>(
+fn mask<'p, T: Transform3 + 'p, S: AosSink, P: BoxPair>(
     run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
-    tight: Tight,
+    tight: Tight<P>,
     words: &[u64],
 ) {
     let AosRun {
@@ -326,7 +445,7 @@ fn mask<'p, T: Transform3 + 'p, S: AosSink>(
                 end += next.count;
             }
             let start = span.start;
-            sink.run(start, &local[start..end], poses.from(start), tight);
+            sink.run(start, &local[start..end], poses, tight);
             continue;
         }
         let mut bits = span.lanes;

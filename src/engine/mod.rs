@@ -49,7 +49,7 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{All, AosPoses, AosRun, AosSink, ClassJob, Tight, takes_aos};
+pub(crate) use aos::{All, AosPoses, AosRun, AosSink, ClassJob, PoseList, Tight, takes_aos};
 
 use active::{List, Mask, Subset};
 

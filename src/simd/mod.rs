@@ -9,12 +9,14 @@
 //! guarantee it (`-C target-cpu=…` or `-C target-feature=+avx2,+fma`).
 
 mod lanes;
+mod pair;
 
 use alloc::vec::Vec;
 
 #[cfg(target_arch = "x86_64")]
 use lanes::Avx8;
 pub(crate) use lanes::{F32s, LaneArray};
+pub(crate) use pair::BoxPair;
 
 /// A code path for the batch kernels.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -182,6 +184,35 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     }
 }
 
+/// A job over AoS 3D boxes, written once over a [`BoxPair`] (two boxes per vector).
+pub(crate) trait PairJob {
+    /// Runs the job with pairs `P`; `#[inline(always)]`, as for [`Job::run`].
+    fn run<P: BoxPair>(self);
+}
+
+/// Runs `job` on `backend`, which the caller has checked is supported: two boxes per AVX
+/// register on the AVX2 and AVX-512 backends, two SSE registers elsewhere. The arithmetic is
+/// `Vec3A`'s in both, so every backend gives the same bits.
+#[allow(unsafe_code)] // calling the `#[target_feature]` wrapper
+pub(crate) fn dispatch_pairs<J: PairJob>(backend: Backend, job: J) {
+    debug_assert!(backend.is_supported());
+    match backend {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the caller checked that `backend` is supported, and the features of both
+        // `Backend::Avx2` and `Backend::Avx512` include AVX2 and FMA, the set
+        // `run_avx2_pairs` enables.
+        Backend::Avx2 | Backend::Avx512 => unsafe { run_avx2_pairs(job) },
+        _ => job.run::<pair::Two>(),
+    }
+}
+
+// The features enabled here are those of `Backend::Avx2.features()` (a test checks they agree).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn run_avx2_pairs<J: PairJob>(job: J) {
+    job.run::<pair::AvxPair>();
+}
+
 /// A job that ignores the lane type: plain array code, compiled with the features of the
 /// backend's dispatch wrapper; it leaves its result in `out`.
 struct Plain<'a, T, F: FnOnce() -> T> {
@@ -261,7 +292,11 @@ mod tests {
     #[test]
     fn backends_check_every_feature_their_code_enables() {
         let source = include_str!("mod.rs");
-        for (backend, wrapper) in [(Backend::Avx2, "run_avx2"), (Backend::Avx512, "run_avx512")] {
+        for (backend, wrapper) in [
+            (Backend::Avx2, "run_avx2"),
+            (Backend::Avx512, "run_avx512"),
+            (Backend::Avx2, "run_avx2_pairs"),
+        ] {
             let at = source
                 .find(&alloc::format!("fn {wrapper}<"))
                 .expect("the wrapper");

@@ -6,8 +6,6 @@ mod quat;
 mod rigid2;
 mod translation;
 
-use glam::Vec3A;
-
 pub use quat::{Rigid3, Similarity3, Trs3};
 pub use rigid2::Rigid2;
 pub use translation::{Translation2, Translation3};
@@ -91,7 +89,7 @@ pub(crate) mod sealed {
     use super::*;
     use crate::extended::ExtendedMap;
     use crate::fields::{Fields, MAX_FIELDS};
-    use crate::kernel::MapKernel;
+    use crate::kernel::{JoinLanes, MapKernel};
     use crate::lane::{Lane, Vector};
 
     /// Poses of a 3D class by name: how generic code reaches the code bvkit compiles once
@@ -134,7 +132,7 @@ pub(crate) mod sealed {
     /// A 3D class on glam's SIMD `Vec3A`, whose lanes are the axes of one box.
     pub trait Simd3: Class<3> {
         /// The class with `Vec3A` lanes.
-        type Simd: MapKernel<Vec3A>;
+        type Simd: JoinLanes;
         /// The class as `Vec3A` lanes.
         fn simd(&self) -> Self::Simd;
     }

@@ -10,8 +10,8 @@ use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 use super::{Class, Named3, Simd3, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
-use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
+use crate::kernel::{JoinLanes, MapKernel};
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
 
@@ -207,6 +207,23 @@ impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatLanes<V, SCALED> {
             (min - pad, max + pad)
         } else {
             (min, max)
+        }
+    }
+}
+
+impl<const SCALED: bool> JoinLanes for QuatLanes<Vec3A, SCALED> {
+    type In<P: Axes> = QuatLanes<P, SCALED>;
+    #[inline(always)]
+    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> QuatLanes<P, SCALED> {
+        QuatLanes {
+            cols: [
+                join(a.cols[0], b.cols[0]),
+                join(a.cols[1], b.cols[1]),
+                join(a.cols[2], b.cols[2]),
+            ],
+            rho: join(a.rho, b.rho),
+            scale: join(a.scale, b.scale),
+            t: join(a.t, b.t),
         }
     }
 }

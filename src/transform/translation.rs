@@ -6,8 +6,8 @@ use super::{Class, Named3, Simd3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
-use crate::kernel::MapKernel;
-use crate::lane::{Lane, Vector};
+use crate::kernel::{JoinLanes, MapKernel};
+use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
 
 /// A 3D translation `x ↦ x + t`.
@@ -87,6 +87,14 @@ impl From<Translation2> for Affine2 {
 #[derive(Clone, Copy, Debug)]
 pub struct TranslationLanes<V> {
     pub t: V,
+}
+
+impl JoinLanes for TranslationLanes<Vec3A> {
+    type In<P: Axes> = TranslationLanes<P>;
+    #[inline(always)]
+    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> TranslationLanes<P> {
+        TranslationLanes { t: join(a.t, b.t) }
+    }
 }
 
 impl<V: Lane> MapKernel<V> for TranslationLanes<V> {
