@@ -2,9 +2,11 @@
 //!
 //! Gathering AoS boxes and transforms into one-field-per-register lanes costs a shuffle per
 //! field per box, more than the kernel itself (measured in `docs/speed.md`). So `&[Aabb3]`
-//! boxes with AoS or shared transforms run [`Aabb3::transformed`] on every active box, on
-//! glam's `Vec3A`: the same bits as the single-box calls on every SIMD backend (never
-//! fused on a default build), and the same contract, the extended path included.
+//! boxes with AoS or shared transforms run the single-box kernel on glam's `Vec3A`
+//! layout, two boxes per vector ([`BoxPair`]: one per 128-bit half), and redo a chunk box by
+//! box with [`Aabb3::transformed`] where its test fails: the same bits as the single-box
+//! calls on every backend (which never fuse), and the same contract, the extended path
+//! included.
 
 use super::Active;
 use super::active::{List, Mask, Subset, Width};
