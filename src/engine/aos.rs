@@ -8,14 +8,14 @@
 //! calls on every backend (which never fuse), and the same contract, the extended path
 //! included.
 
+use core::marker::PhantomData;
+
 use super::Active;
 use super::active::{List, Mask, Subset, Width};
 use crate::aabb::Aabb3;
+use crate::kernel::{JoinLanes, MapKernel};
 use crate::layout::Maps;
 use crate::method::{Method, Rounding};
-use core::marker::PhantomData;
-
-use crate::kernel::{JoinLanes, MapKernel};
 use crate::simd::{self, Backend, BoxPair, PairJob};
 use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
@@ -65,8 +65,8 @@ impl AosSink for &mut [Aabb3] {
 const CHUNK: usize = 64;
 
 /// The single-box kernel of one method and rounding, and its pairs `P`. A method call
-/// rather than a closure: a closure was compiled out of line, with the method and rounding
-/// as run-time values where each loop has them as constants.
+/// rather than a closure: a closure was compiled out of line, with the method as a run-time
+/// value where each loop has it as a constant.
 pub(crate) struct Tight<P> {
     method: Method,
     rounding: Rounding,
@@ -120,10 +120,9 @@ impl<P: BoxPair> Tight<P> {
                     max: max1,
                 };
             }
-            if let (Some(l), Some(o)) = (local.get(local.len() & !1), out.last_mut())
-                && local.len() % 2 == 1
-            {
-                *o = self.of(l, poses.at(first + local.len() - 1));
+            if local.len() % 2 == 1 {
+                let k = local.len() - 1;
+                out[k] = self.of(&local[k], poses.at(first + k));
             }
             if !P::all_xyz(stands) {
                 core::hint::cold_path();
