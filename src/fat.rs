@@ -1,9 +1,9 @@
 //! Fat boxes: a tight box grown by a margin and rounded outward, and the test that a tight
 //! box still lies inside one.
 
+use crate::aabb::{Aabb2, Aabb3};
 use crate::lane::{Lane, Vector};
 use crate::num::pow2;
-use crate::{Aabb2, Aabb3};
 use glam::Vec3A;
 
 /// How much a fat box exceeds the tight box it was made from, per axis:

@@ -148,7 +148,6 @@ extern crate std;
 
 mod aabb;
 mod batch;
-mod broadphase;
 mod engine;
 mod error;
 mod extended;
@@ -168,8 +167,7 @@ mod transform;
 pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
-pub use batch::Batch;
-pub use broadphase::{LargePose, LargeRigid3, LargeWorld, Moved, PoseSource, Swept};
+pub use batch::{Batch, LargePose, LargeRigid3, LargeWorld, Moved, PoseSource, Swept};
 pub use engine::Active;
 pub use error::{BatchError, TransformError};
 pub use fat::Margin;

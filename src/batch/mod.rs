@@ -1,17 +1,30 @@
-//! Batch transforms: [`Batch`], a thin public layer over the engine.
+//! [`Batch`] and its verbs, a thin public layer over the engine, a file each:
+//! [`Batch::transform`] (`transform`), [`Batch::update`] with the broadphase's fat boxes,
+//! moved set and pose sources (`update`, `moved`, `large`), and `transform_par` (`parallel`,
+//! feature `rayon`).
 
+mod large;
+mod moved;
 #[cfg(feature = "rayon")]
 mod parallel;
+mod transform;
+mod update;
+
+pub use large::{LargePose, LargeRigid3};
+pub use moved::Moved;
+pub use update::{LargeWorld, PoseSource, Swept};
 
 use core::marker::PhantomData;
 
+#[cfg(doc)]
 use crate::aabb::Aabb3;
-use crate::engine::{Active, All, AosPoses, AosRun, ClassJob, Engine, Poses, Store, takes_aos};
+use crate::engine::Poses;
 use crate::error::BatchError;
-use crate::layout::{BoxSink, BoxSource, Maps, ReadBoxes, ReadMaps, TransformSource, WriteBoxes};
+#[cfg(doc)]
+use crate::layout::{BoxSink, BoxSource, TransformSource};
+use crate::layout::{ReadBoxes, ReadMaps, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-use crate::transform::Transform3;
 
 /// How a batch runs: the method, the rounding and the backend.
 ///
@@ -112,108 +125,6 @@ impl Batch {
     pub fn backend(&self) -> Backend {
         self.backend
     }
-
-    /// `out[k] = local[k]` through transform `k` (or the shared transform) for every `k`:
-    /// every layout, every transform class, in 3D and 2D.
-    ///
-    /// # Errors
-    /// [`BatchError::LengthMismatch`] unless the boxes, the transforms (unless shared) and
-    /// the output have the same length, and the columns of a SoA layout agree; `out` is
-    /// then untouched.
-    pub fn transform<const N: usize>(
-        &self,
-        local: impl BoxSource<N>,
-        xf: impl TransformSource<N>,
-        mut out: impl BoxSink<N>,
-    ) -> Result<(), BatchError> {
-        let len = checked_len(&local, &xf, &mut out)?;
-        self.transform_checked(local, xf, out, len);
-        Ok(())
-    }
-
-    /// [`Batch::transform`], its lengths checked: the layouts pick the loop when the call
-    /// site is compiled, so that AoS 3D layouts compile no lane loop there and call code
-    /// compiled once in bvkit.
-    #[inline(always)]
-    fn transform_checked<const N: usize, B: BoxSource<N>, X: TransformSource<N>, O: BoxSink<N>>(
-        &self,
-        local: B,
-        xf: X,
-        mut out: O,
-        len: usize,
-    ) {
-        if AosLayouts::<N, B, X, O>::ALL {
-            let (Some(local), Some(poses), Some(out)) =
-                (local.aabb3s(), xf.aos(), out.aabb3s_mut())
-            else {
-                unreachable!("AoS 3D layouts always convert (a test checks every layout)");
-            };
-            self.transform_aos(local, poses, out);
-        } else {
-            self.transform_lanes(local, xf, out, len);
-        }
-    }
-
-    /// [`Batch::transform`] in the lane loop, its lengths checked.
-    #[inline(always)]
-    fn transform_lanes<const N: usize>(
-        &self,
-        local: impl BoxSource<N>,
-        xf: impl TransformSource<N>,
-        out: impl BoxSink<N>,
-        len: usize,
-    ) {
-        let engine = Engine {
-            local,
-            poses: xf,
-            sink: Store {
-                out,
-                stream: len.saturating_mul(2 * N * size_of::<f32>()) > Self::NON_TEMPORAL_BYTES,
-            },
-            len,
-            active: Active::All,
-            method: self.method,
-            rounding: self.rounding,
-        };
-        engine.run_every(self.backend, !self.deterministic);
-    }
-
-    /// [`Batch::transform`] of AoS 3D boxes with AoS or shared poses, lengths checked:
-    /// compiled here once per class, for every call site.
-    #[inline(never)]
-    fn transform_aos(&self, local: &[Aabb3], poses: AosPoses<'_>, out: &mut [Aabb3]) {
-        /// The transform of one class.
-        struct Job<'b, 'o> {
-            batch: &'b Batch,
-            local: &'b [Aabb3],
-            out: &'o mut [Aabb3],
-        }
-        impl<'a> ClassJob<'a> for Job<'_, '_> {
-            fn run<T: Transform3>(self, maps: Maps<'a, T>) {
-                let Job { batch, local, out } = self;
-                if takes_aos(batch.backend) {
-                    let run = AosRun {
-                        local,
-                        sink: out,
-                        active: All,
-                        method: batch.method,
-                        rounding: batch.rounding,
-                    };
-                    return run.run(maps, batch.backend);
-                }
-                let len = local.len();
-                match maps {
-                    Maps::Each(poses) => batch.transform_lanes(local, poses, out, len),
-                    Maps::Shared(pose) => batch.transform_lanes(local, pose, out, len),
-                }
-            }
-        }
-        poses.run(Job {
-            batch: self,
-            local,
-            out,
-        });
-    }
 }
 
 /// Three layouts as types: boxes `B` in, poses `X`, boxes `O` out.
@@ -248,6 +159,7 @@ mod tests {
 
     use super::*;
     use crate::aabb::Aabb3;
+    use crate::engine::{Active, Engine, Store};
     use crate::layout::{Aabb3x8, Block8};
     use crate::simd::{F32s, LaneArray};
     use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};

@@ -7,7 +7,7 @@ use super::eigen::principal_axes;
 use super::obb::{Obb3, tight_frames};
 use super::search::compass_search;
 use super::{Fit, FitError};
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use crate::num::sqrt;
 use alloc::vec::Vec;
 use core::f64::consts::PI;

@@ -2,7 +2,7 @@
 //! extremal points and moments are sweeps in lanes ([`super::sweep`]).
 
 use super::FitError;
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3, Vec3A};
 

@@ -11,7 +11,7 @@ use super::rect::min_area_rectangle;
 use super::search::compass_search;
 use super::sweep;
 use super::{Fit, FitError};
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use alloc::collections::BTreeMap;
 use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
 

@@ -4,7 +4,7 @@ use super::ball::smallest_ball;
 use super::bound::{Bounded, largest, segment_distance};
 use super::cloud::{self, exact};
 use super::{Fit, FitError};
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3, Vec3A};
 

@@ -2,7 +2,7 @@
 //!
 //! Each sweep is one pass on the running CPU's best backend ([`Backend::detect`]), run
 //! unfused, so that its result does not depend on the backend: the same bits on every CPU.
-//! A sweep is plain array code over blocks of [`WIDTH`] points, transposed into coordinate
+//! A sweep is plain array code over groups of [`WIDTH`] points, transposed into coordinate
 //! columns and compiled inside the backend's dispatch wrapper, so that it vectorises for
 //! its instructions; sums keep [`WIDTH`] partial sums (point `i` goes to sum `i mod WIDTH`),
 //! added in order at the end.
@@ -13,22 +13,22 @@
 //!
 //! Two lessons of the measurements are kept in the code: a sweep keeps its state in locals
 //! that it returns (conditional writes through captured references do not vectorise), and
-//! reads full blocks in place (a block copied to the stack and read back in another shape
+//! reads full groups in place (a group copied to the stack and read back in another shape
 //! stalls store forwarding).
 
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use crate::simd;
 use alloc::vec::Vec;
 use glam::{DMat3, DVec3, Mat3A, Vec3, Vec3A};
 
-/// Points per block.
+/// Points per group.
 const WIDTH: usize = 8;
 
-/// The full blocks of `points`, then the last, partial one (if any) padded with `pad`, and
-/// how many of its points are real. Full blocks are read in place: a block copied to the
+/// The full groups of `points`, then the last, partial one (if any) padded with `pad`, and
+/// how many of its points are real. Full groups are read in place: a group copied to the
 /// stack and read back in another shape stalls store forwarding.
 #[inline(always)]
-fn blocks(
+fn groups(
     points: &[Vec3],
     pad: Vec3,
 ) -> (impl Iterator<Item = &[Vec3; WIDTH]>, [Vec3; WIDTH], usize) {
@@ -42,20 +42,20 @@ fn blocks(
 /// `array::from_fn` are not always inlined), so that the transposition compiles to vector
 /// loads and shuffles.
 #[inline(always)]
-fn columns(block: &[Vec3; WIDTH]) -> [[f32; WIDTH]; 3] {
+fn columns(group: &[Vec3; WIDTH]) -> [[f32; WIDTH]; 3] {
     let mut c = [[0.0f32; WIDTH]; 3];
     for j in 0..WIDTH {
-        c[0][j] = block[j].x;
-        c[1][j] = block[j].y;
-        c[2][j] = block[j].z;
+        c[0][j] = group[j].x;
+        c[1][j] = group[j].y;
+        c[2][j] = group[j].z;
     }
     c
 }
 
 /// [`columns`] as exact `f64`.
 #[inline(always)]
-fn columns_f64(block: &[Vec3; WIDTH]) -> [[f64; WIDTH]; 3] {
-    let f = columns(block);
+fn columns_f64(group: &[Vec3; WIDTH]) -> [[f64; WIDTH]; 3] {
+    let f = columns(group);
     let mut c = [[0.0f64; WIDTH]; 3];
     for i in 0..3 {
         for j in 0..WIDTH {
@@ -75,9 +75,9 @@ pub(crate) fn bounds(points: &[Vec3]) -> Result<Aabb3, usize> {
             let mut lo = [[f32::INFINITY; WIDTH]; 3];
             let mut hi = [[f32::NEG_INFINITY; WIDTH]; 3];
             let mut finite = [true; WIDTH];
-            let (full, tail, _) = blocks(points, pad);
-            for block in full.chain([&tail]) {
-                let c = columns(block);
+            let (full, tail, _) = groups(points, pad);
+            for group in full.chain([&tail]) {
+                let c = columns(group);
                 for i in 0..3 {
                     for j in 0..WIDTH {
                         let x = c[i][j];
@@ -125,9 +125,9 @@ pub(crate) fn projection_ranges<const N: usize>(
                 let mut lo = [[f64::INFINITY; WIDTH]; 3];
                 let mut hi = [[f64::NEG_INFINITY; WIDTH]; 3];
                 // Padding with a point of the set changes no extreme.
-                let (full, tail, _) = blocks(points, pad);
-                for block in full.chain([&tail]) {
-                    let [x, y, z] = columns_f64(block);
+                let (full, tail, _) = groups(points, pad);
+                for group in full.chain([&tail]) {
+                    let [x, y, z] = columns_f64(group);
                     for k in 0..3 {
                         for j in 0..WIDTH {
                             let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
@@ -145,7 +145,7 @@ pub(crate) fn projection_ranges<const N: usize>(
     })
 }
 
-/// Blocks per chunk of [`summary`].
+/// Groups per chunk of [`summary`].
 const CHUNK: usize = 32;
 
 /// How many sample directions [`summary`] projects on.
@@ -210,7 +210,7 @@ const ENTRIES: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2
 /// the sweeps are bound by memory, not arithmetic).
 ///
 /// **Extremes.** The lanes keep only the least and greatest values of each chunk of
-/// [`CHUNK`] blocks; a chunk that strictly improves an extreme becomes its chunk, and the
+/// [`CHUNK`] groups; a chunk that strictly improves an extreme becomes its chunk, and the
 /// first point of that chunk with the extreme value is found at the end, by evaluating the
 /// same sums one point at a time (the same bits: IEEE operations in the same order).
 ///
@@ -239,8 +239,8 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             for (c, chunk) in points.chunks_exact(CHUNK * WIDTH).enumerate() {
                 let mut lo = [[f32::INFINITY; WIDTH]; DIRECTIONS];
                 let mut hi = [[f32::NEG_INFINITY; WIDTH]; DIRECTIONS];
-                for block in chunk.as_chunks::<WIDTH>().0 {
-                    let [x, y, z] = columns(block);
+                for group in chunk.as_chunks::<WIDTH>().0 {
+                    let [x, y, z] = columns(group);
                     for j in 0..WIDTH {
                         let q = projections(x[j], y[j], z[j]);
                         for k in 0..DIRECTIONS {
@@ -370,7 +370,7 @@ mod tests {
 
     /// The signed sums are the dot products with the sample directions, and the extremal
     /// points are the first points of least and greatest dot product, as a plain loop finds
-    /// them (ties included: the points repeat, and the tail is longer than a block).
+    /// them (ties included: the points repeat, and the tail is longer than a group).
     #[test]
     fn extremal_points_are_the_first_extremes_of_the_dot_products() {
         let mut points: Vec<Vec3> = (0..CHUNK * WIDTH * 3 + 13)

@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3, Vec3A};
 
 use super::build::{self, PrimBox};
 use super::nodes::{Compact, Layout, PRIMITIVE, Ref};
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 
 /// Why a mesh or a tree could not be built or refitted.
 #[derive(Clone, Copy, Debug, PartialEq)]

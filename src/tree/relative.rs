@@ -299,7 +299,7 @@ impl Relative {
     /// center and extent with the rounding the pad covers; for the reaches given to
     /// [`Relative::new`]. An empty box never overlaps; NaN faces always do (conservative).
     #[must_use]
-    pub fn overlaps(&self, a: &crate::Aabb3, b: &crate::Aabb3) -> bool {
+    pub fn overlaps(&self, a: &crate::aabb::Aabb3, b: &crate::aabb::Aabb3) -> bool {
         if a.min.cmpgt(a.max).any() || b.min.cmpgt(b.max).any() {
             return false;
         }

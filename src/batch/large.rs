@@ -4,7 +4,7 @@
 use crate::num::{pow2, round_up, two_sum};
 use glam::{Affine3A, DAffine3, DVec3, Quat, Vec3A};
 
-use crate::Aabb3;
+use crate::aabb::Aabb3;
 use crate::method::{Method, Rounding};
 use crate::transform::Rigid3;
 

@@ -1,11 +1,12 @@
 //! The per-frame broadphase update (documented on [`Batch::update`]): a thin public layer
 //! over the engine, whose sink is the fat boxes and the moved set.
 
-mod large;
-mod moved;
-
+use super::large::LargePose;
+#[cfg(doc)]
+use super::large::LargeRigid3;
+use super::moved::Moved;
+use super::{AosLayouts, Batch};
 use crate::aabb::Aabb3;
-use crate::batch::{AosLayouts, Batch};
 use crate::engine::{
     Active, AosPoses, AosRun, AosSink, ClassJob, Engine, PoseList, Poses, Redo, Sink, Tight,
     takes_aos,
@@ -18,9 +19,6 @@ use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, BoxPair, LaneArray};
 use crate::transform::Transform3;
-
-pub use large::{LargePose, LargeRigid3};
-pub use moved::Moved;
 
 use glam::DVec3;
 
@@ -647,7 +645,7 @@ mod tests {
         let (l8, p8): (alloc::vec::Vec<Aabb3x8>, alloc::vec::Vec<Rigid3x8>) =
             (Block8::pack(&local), Block8::pack(&poses));
         let (ls, ps) = (Soa::from_slice(&local), Soa::from_slice(&poses));
-        for backend in crate::Backend::supported() {
+        for backend in crate::simd::Backend::supported() {
             for (active, set) in [
                 (Active::Mask(&mask), mask[0]),
                 (
