@@ -34,14 +34,21 @@ impl JoinLanes for AffineLanes<Vec3A, 3> {
     #[inline(always)]
     fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> AffineLanes<P, 3> {
         AffineLanes {
-            cols: [
-                join(a.cols[0], b.cols[0]),
-                join(a.cols[1], b.cols[1]),
-                join(a.cols[2], b.cols[2]),
-            ],
+            cols: join_cols(&a.cols, &b.cols, &join),
             t: join(a.t, b.t),
         }
     }
+}
+
+/// The three columns of two maps side by side, `join(a's, b's)` each: the columns of every
+/// [`JoinLanes`] map.
+#[inline(always)]
+pub(crate) fn join_cols<P>(
+    a: &[Vec3A; 3],
+    b: &[Vec3A; 3],
+    join: impl Fn(Vec3A, Vec3A) -> P,
+) -> [P; 3] {
+    [join(a[0], b[0]), join(a[1], b[1]), join(a[2], b[2])]
 }
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.

@@ -216,11 +216,7 @@ impl<const SCALED: bool> JoinLanes for QuatLanes<Vec3A, SCALED> {
     #[inline(always)]
     fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> QuatLanes<P, SCALED> {
         QuatLanes {
-            cols: [
-                join(a.cols[0], b.cols[0]),
-                join(a.cols[1], b.cols[1]),
-                join(a.cols[2], b.cols[2]),
-            ],
+            cols: kernel::join_cols(&a.cols, &b.cols, &join),
             rho: join(a.rho, b.rho),
             scale: join(a.scale, b.scale),
             t: join(a.t, b.t),
