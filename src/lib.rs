@@ -148,6 +148,8 @@ extern crate std;
 
 mod aabb;
 mod batch;
+// The broadphase's dynamic tree, fed by the moved set (issue 47).
+pub mod broadphase;
 mod engine;
 mod error;
 mod extended;

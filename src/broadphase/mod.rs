@@ -1,0 +1,643 @@
+//! A dynamic tree of fat boxes that consumes an update's moved set and reports the pairs
+//! whose overlap began (and, on request, ended) in each frame.
+//!
+//! [`DynamicTree`] holds one proxy per body, keyed by the body's index in the slices a
+//! [`Batch::update`](crate::Batch::update) reads, with the body's fat box. Each frame the
+//! engine hands it [`Moved::indices`](crate::Moved::indices) and the fat boxes; the tree
+//! rewrites the moved proxies' boxes, carries each change up only while a parent's box
+//! changes, and searches pairs only from the moved proxies:
+//!
+//! ```
+//! use bvkit::broadphase::{DynamicTree, Pairs};
+//! use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
+//! use glam::{Quat, Vec3A};
+//!
+//! let local = vec![Aabb3::new(Vec3A::splat(-0.5), Vec3A::splat(0.5)); 3];
+//! let mut poses: Vec<Rigid3> = (0..3)
+//!     .map(|i| Rigid3::new(Quat::IDENTITY, Vec3A::X * 3.0 * i as f32))
+//!     .collect();
+//! let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+//! let margin = Margin::new(0.1, 0.0);
+//! let (mut fat, mut moved) = (vec![Aabb3::EMPTY; 3], Moved::new());
+//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+//!
+//! let mut tree = DynamicTree::from_boxes(&fat)?;
+//! let mut pairs = Pairs::with_ended();
+//! tree.update(moved.indices(), &fat, &mut pairs)?; // the first frame: no box overlaps
+//! assert!(pairs.begun.is_empty());
+//!
+//! poses[1].translation.x = 1.0; // body 1 now overlaps body 0
+//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+//! tree.update(moved.indices(), &fat, &mut pairs)?;
+//! assert_eq!(pairs.begun, [(0, 1)]);
+//!
+//! poses[1].translation.x = 3.0;
+//! batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
+//! tree.update(moved.indices(), &fat, &mut pairs)?;
+//! assert_eq!(pairs.ended, [(0, 1)]);
+//! # Ok::<(), Box<dyn core::error::Error>>(())
+//! ```
+//!
+//! **What a frame reports.** Between two updates, a pair's overlap *begins* when the two fat
+//! boxes overlap now (closed boxes: touching counts) and did not at the last update, and
+//! *ends* the other way round; a body inserted, removed or parked since counts as having
+//! had, or having, no box. This is exact: the tree loses no pair and invents none, whatever
+//! moved, because its node boxes are exact unions (`min`/`max` round nothing), and the
+//! tests check every frame against all pairs by brute force.
+//!
+//! **Bad boxes.** A NaN, infinite or inverted box is refused: [`DynamicTree::insert`]
+//! returns an error, and [`DynamicTree::update`] *parks* the proxy (it leaves the tree, its
+//! pairs end, and its id is listed in [`Pairs::refused`]) until a later update gives it a
+//! finite box. No such box ever reaches a node, so no later query or rebuild meets one.
+//!
+//! **Sleep.** Sleeping proxies live in a second hierarchy: the awake one, which every moved
+//! proxy rewrites, stays the size of the awake set. Pairs between the two are found as any
+//! other (a moved proxy queries both).
+
+mod wide;
+
+use crate::aabb::Aabb3;
+use crate::layout::BoxSource;
+use alloc::vec::Vec;
+use core::fmt;
+use wide::{Hierarchy, Places, Slot, overlap};
+
+/// Why the tree refused an input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BroadphaseError {
+    /// A box with a NaN or infinite face, or a face below its opposite one.
+    InvalidBox {
+        /// The proxy.
+        id: u32,
+    },
+    /// [`DynamicTree::insert`] of a proxy already in the tree.
+    Duplicate {
+        /// The proxy.
+        id: u32,
+    },
+    /// An id of `2^31 − 2` or more (the tree packs ids in 31 bits).
+    IdTooLarge {
+        /// The id.
+        id: u32,
+    },
+    /// The moved list of [`DynamicTree::update`] is not strictly ascending.
+    Unsorted,
+    /// A moved id past the end of the fat boxes.
+    MissingBox {
+        /// The moved id.
+        id: u32,
+        /// The number of fat boxes.
+        len: usize,
+    },
+    /// The fat boxes' layout is inconsistent (its columns disagree in length).
+    Layout,
+}
+
+impl fmt::Display for BroadphaseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidBox { id } => {
+                write!(
+                    f,
+                    "proxy {id}: the box has a NaN or infinite face, or min > max"
+                )
+            }
+            Self::Duplicate { id } => write!(f, "proxy {id} is already in the tree"),
+            Self::IdTooLarge { id } => write!(f, "proxy id {id} is not below 2^31 - 2"),
+            Self::Unsorted => write!(f, "the moved ids are not strictly ascending"),
+            Self::MissingBox { id, len } => {
+                write!(f, "moved id {id} is past the {len} fat boxes")
+            }
+            Self::Layout => write!(f, "the fat boxes' columns disagree in length"),
+        }
+    }
+}
+
+impl core::error::Error for BroadphaseError {}
+
+/// What a frame of [`DynamicTree::update`] found. Each pair is `(smaller id, larger id)`,
+/// once; the order of the pairs is deterministic but unspecified.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Pairs {
+    /// The pairs whose fat boxes overlap now and did not at the last update.
+    pub begun: Vec<(u32, u32)>,
+    /// The pairs whose fat boxes overlapped at the last update and do not now (filled only
+    /// when made by [`Pairs::with_ended`]).
+    pub ended: Vec<(u32, u32)>,
+    /// Moved proxies whose new box was refused (NaN, infinite or inverted), now parked.
+    pub refused: Vec<u32>,
+    ended_wanted: bool,
+}
+
+impl Pairs {
+    /// Begun pairs only.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Begun and ended pairs (the ended ones cost a second query per moved proxy).
+    #[must_use]
+    pub fn with_ended() -> Self {
+        Self {
+            ended_wanted: true,
+            ..Self::default()
+        }
+    }
+
+    fn clear(&mut self) {
+        self.begun.clear();
+        self.ended.clear();
+        self.refused.clear();
+    }
+}
+
+/// Where a proxy is: nowhere, parked, or a slot of one of the two hierarchies.
+const ABSENT: u32 = u32::MAX;
+const PARKED: u32 = u32::MAX - 1;
+const ASLEEP: u32 = 1 << 31;
+/// Ids are packed in 31 bits, with the two codes above kept out of range.
+const MAX_ID: u32 = (1 << 31) - 2;
+
+/// A proxy whose box changed since the last update: its box then and now (the empty box
+/// when it had, or has, none).
+#[derive(Clone, Copy, Debug)]
+struct Change {
+    id: u32,
+    old: Aabb3,
+    new: Aabb3,
+}
+
+/// Sends a hierarchy's proxy moves to the per-proxy places.
+struct Placer<'a> {
+    at: &'a mut [u32],
+    asleep: bool,
+}
+
+impl Places for Placer<'_> {
+    #[inline(always)]
+    fn place(&mut self, id: u32, slot: Slot) {
+        self.at[id as usize] = slot.0 | if self.asleep { ASLEEP } else { 0 };
+    }
+}
+
+/// A box the tree accepts: every face finite, `min <= max`.
+fn accepts(b: &Aabb3) -> bool {
+    b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()
+}
+
+/// A dynamic tree of fat boxes, fed by the moved set (see the [module docs](self)).
+#[derive(Clone, Debug, Default)]
+pub struct DynamicTree {
+    awake: Hierarchy,
+    asleep: Hierarchy,
+    /// Per id: [`ABSENT`], [`PARKED`], or a slot (with [`ASLEEP`] in the asleep hierarchy).
+    at: Vec<u32>,
+    /// Per id: 1 + its index in `changes` (during an update) or in `pending` (between
+    /// updates), 0 when it is in neither.
+    mark: Vec<u32>,
+    /// Proxies inserted, removed or parked since the last update, each with its box then.
+    pending: Vec<Change>,
+    len: usize,
+    changes: Vec<Change>,
+    fresh: Vec<(u32, Aabb3)>,
+    stack: Vec<u32>,
+}
+
+impl DynamicTree {
+    /// An empty tree.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A tree whose proxy `i` is awake with box `i` of `fat`, built balanced (as
+    /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first update.
+    ///
+    /// # Errors
+    /// [`BroadphaseError::InvalidBox`] for the first NaN, infinite or inverted box,
+    /// [`BroadphaseError::IdTooLarge`] for `2^31 − 2` boxes or more, and
+    /// [`BroadphaseError::Layout`] for inconsistent columns.
+    pub fn from_boxes(fat: impl BoxSource<3>) -> Result<Self, BroadphaseError> {
+        let len = fat.len().map_err(|_| BroadphaseError::Layout)?;
+        if len > MAX_ID as usize {
+            return Err(BroadphaseError::IdTooLarge { id: MAX_ID });
+        }
+        let mut items = Vec::with_capacity(len);
+        for i in 0..len {
+            let (min, max) = fat.get(i);
+            let b = Aabb3::new(min.into(), max.into());
+            if !accepts(&b) {
+                return Err(BroadphaseError::InvalidBox { id: i as u32 });
+            }
+            items.push((i as u32, b));
+        }
+        let mut tree = Self {
+            at: alloc::vec![ABSENT; len],
+            mark: (1..=len as u32).collect(),
+            pending: (0..len as u32)
+                .map(|id| Change {
+                    id,
+                    old: Aabb3::EMPTY,
+                    new: Aabb3::EMPTY,
+                })
+                .collect(),
+            len,
+            ..Self::default()
+        };
+        let (h, mut places) = tree.hierarchy(false);
+        *h = Hierarchy::build(&mut items, &mut places);
+        Ok(tree)
+    }
+
+    /// The number of proxies, parked ones included.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when the tree holds no proxy.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Proxy `id`'s fat box, or `None` when it is absent or parked.
+    #[must_use]
+    pub fn get(&self, id: u32) -> Option<Aabb3> {
+        let at = *self.at.get(id as usize)?;
+        match at {
+            ABSENT | PARKED => None,
+            at if at & ASLEEP != 0 => Some(self.asleep.get(Slot(at & !ASLEEP))),
+            at => Some(self.awake.get(Slot(at))),
+        }
+    }
+
+    /// True when proxy `id` is in the tree (placed or parked).
+    #[must_use]
+    pub fn contains(&self, id: u32) -> bool {
+        self.at.get(id as usize).is_some_and(|&at| at != ABSENT)
+    }
+
+    /// True when proxy `id` is parked: its last box was refused.
+    #[must_use]
+    pub fn is_parked(&self, id: u32) -> bool {
+        self.at.get(id as usize) == Some(&PARKED)
+    }
+
+    /// True when proxy `id` is asleep.
+    #[must_use]
+    pub fn is_asleep(&self, id: u32) -> bool {
+        self.at
+            .get(id as usize)
+            .is_some_and(|&at| at != ABSENT && at != PARKED && at & ASLEEP != 0)
+    }
+
+    /// The nodes of the two hierarchies (8 children each, 256 bytes).
+    #[must_use]
+    pub fn nodes(&self) -> usize {
+        self.awake.nodes() + self.asleep.nodes()
+    }
+
+    fn grow(&mut self, id: u32) -> Result<(), BroadphaseError> {
+        if id >= MAX_ID {
+            return Err(BroadphaseError::IdTooLarge { id });
+        }
+        if self.at.len() <= id as usize {
+            self.at.resize(id as usize + 1, ABSENT);
+            self.mark.resize(id as usize + 1, 0);
+        }
+        Ok(())
+    }
+
+    /// The box proxy `id` has now, or the empty box.
+    fn current(&self, id: u32) -> Aabb3 {
+        self.get(id).unwrap_or(Aabb3::EMPTY)
+    }
+
+    /// Notes that `id`'s box is about to change outside an update (its box at the last
+    /// update is the one it has now, unless it already changed since).
+    fn note(&mut self, id: u32) {
+        if self.mark[id as usize] == 0 {
+            let old = self.current(id);
+            self.pending.push(Change {
+                id,
+                old,
+                new: Aabb3::EMPTY,
+            });
+            self.mark[id as usize] = self.pending.len() as u32;
+        }
+    }
+
+    fn hierarchy(&mut self, asleep: bool) -> (&mut Hierarchy, Placer<'_>) {
+        let h = if asleep {
+            &mut self.asleep
+        } else {
+            &mut self.awake
+        };
+        (
+            h,
+            Placer {
+                at: &mut self.at,
+                asleep,
+            },
+        )
+    }
+
+    /// Takes placed proxy `id` out of its hierarchy; returns whether it was asleep.
+    fn take_out(&mut self, id: u32) -> bool {
+        let at = self.at[id as usize];
+        let asleep = at & ASLEEP != 0;
+        let (h, _) = self.hierarchy(asleep);
+        h.remove(Slot(at & !ASLEEP));
+        asleep
+    }
+
+    fn place(&mut self, id: u32, b: &Aabb3, asleep: bool) {
+        let (h, mut places) = self.hierarchy(asleep);
+        h.insert(id, b, &mut places);
+    }
+
+    /// Adds proxy `id` (awake) with fat box `fat`; its pairs begin at the next update.
+    ///
+    /// # Errors
+    /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
+    /// [`BroadphaseError::Duplicate`] when `id` is in the tree,
+    /// [`BroadphaseError::IdTooLarge`] from `2^31 − 2` on; the tree is then unchanged.
+    pub fn insert(&mut self, id: u32, fat: Aabb3) -> Result<(), BroadphaseError> {
+        if !accepts(&fat) {
+            return Err(BroadphaseError::InvalidBox { id });
+        }
+        self.grow(id)?;
+        if self.at[id as usize] != ABSENT {
+            return Err(BroadphaseError::Duplicate { id });
+        }
+        self.note(id);
+        self.place(id, &fat, false);
+        self.len += 1;
+        Ok(())
+    }
+
+    /// Removes proxy `id`; its pairs end at the next update. Returns false when it was not
+    /// in the tree.
+    pub fn remove(&mut self, id: u32) -> bool {
+        if !self.contains(id) {
+            return false;
+        }
+        self.note(id);
+        if !self.is_parked(id) {
+            self.take_out(id);
+        }
+        self.at[id as usize] = ABSENT;
+        self.len -= 1;
+        true
+    }
+
+    /// Moves the awake proxies among `ids` to the asleep hierarchy (an island going to
+    /// sleep); their boxes and pairs do not change. Other ids are ignored.
+    pub fn sleep(&mut self, ids: &[u32]) {
+        self.move_between(ids, true);
+    }
+
+    /// Moves the asleep proxies among `ids` back to the awake hierarchy.
+    pub fn wake(&mut self, ids: &[u32]) {
+        self.move_between(ids, false);
+    }
+
+    fn move_between(&mut self, ids: &[u32], to_asleep: bool) {
+        for &id in ids {
+            let Some(b) = self.get(id) else { continue };
+            if self.is_asleep(id) != to_asleep {
+                self.take_out(id);
+                self.place(id, &b, to_asleep);
+            }
+        }
+    }
+
+    /// Rebuilds both hierarchies from their proxies, balanced (median splits of the widest
+    /// spread of centres). Boxes and pairs do not change; queries get faster where moves
+    /// have mixed distant proxies under one node.
+    pub fn rebuild(&mut self) {
+        for asleep in [false, true] {
+            let (h, mut places) = self.hierarchy(asleep);
+            let mut items = h.proxies();
+            *h = Hierarchy::build(&mut items, &mut places);
+        }
+    }
+
+    /// Calls `hit(id)` for every placed proxy whose fat box overlaps `b` (closed boxes).
+    pub fn query(&self, b: &Aabb3, mut hit: impl FnMut(u32)) {
+        let mut stack = Vec::new();
+        for h in [&self.awake, &self.asleep] {
+            h.query(b, &mut stack, |id, _| hit(id));
+        }
+    }
+
+    /// Every pair of placed proxies whose fat boxes overlap, as `(smaller, larger)`,
+    /// ascending: what a narrow phase starts from.
+    #[must_use]
+    pub fn overlapping_pairs(&self) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        let mut stack = Vec::new();
+        for h in [&self.awake, &self.asleep] {
+            for (id, b) in h.proxies() {
+                for g in [&self.awake, &self.asleep] {
+                    g.query(&b, &mut stack, |other, _| {
+                        if other > id {
+                            out.push((id, other));
+                        }
+                    });
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// One frame: the proxies in `moved` (strictly ascending ids, as
+    /// [`Moved::indices`](crate::Moved::indices)) take their boxes from `fat` (indexed by id,
+    /// in any box layout the batch writes); then `pairs` receives the pairs that began (and
+    /// ended) since the last update, the inserts and removes since then included. Moved ids
+    /// not in the tree are ignored; a refused box parks its proxy (module docs).
+    ///
+    /// # Errors
+    /// [`BroadphaseError::Unsorted`], [`BroadphaseError::MissingBox`] or
+    /// [`BroadphaseError::Layout`], before anything changes.
+    pub fn update(
+        &mut self,
+        moved: &[u32],
+        fat: impl BoxSource<3>,
+        pairs: &mut Pairs,
+    ) -> Result<(), BroadphaseError> {
+        if !moved.is_sorted_by(|a, b| a < b) {
+            return Err(BroadphaseError::Unsorted);
+        }
+        let len = fat.len().map_err(|_| BroadphaseError::Layout)?;
+        if let Some(&id) = moved.last()
+            && id as usize >= len
+        {
+            return Err(BroadphaseError::MissingBox { id, len });
+        }
+        let mut fresh = core::mem::take(&mut self.fresh);
+        fresh.clear();
+        for &id in moved {
+            if self.contains(id) {
+                let (min, max) = fat.get(id as usize);
+                fresh.push((id, Aabb3::new(min.into(), max.into())));
+            }
+        }
+        self.frame(&fresh, pairs);
+        self.fresh = fresh;
+        Ok(())
+    }
+
+    /// [`DynamicTree::update`] once the moved proxies' boxes are read (`fresh`, ascending).
+    fn frame(&mut self, fresh: &[(u32, Aabb3)], pairs: &mut Pairs) {
+        pairs.clear();
+        let mut changes = core::mem::take(&mut self.changes);
+        changes.clear();
+        // The changes: the moved proxies merged with the pending ones, ascending.
+        let mut pending = core::mem::take(&mut self.pending);
+        pending.sort_unstable_by_key(|c| c.id);
+        let mut p = pending.iter().peekable();
+        for &(id, b) in fresh {
+            while let Some(c) = p.next_if(|c| c.id < id) {
+                changes.push(Change {
+                    new: self.current(c.id),
+                    ..*c
+                });
+            }
+            let old = match p.next_if(|c| c.id == id) {
+                Some(c) => c.old,
+                None => self.current(id),
+            };
+            let new = if accepts(&b) {
+                match self.at[id as usize] {
+                    PARKED => self.place(id, &b, false),
+                    at => {
+                        let (h, _) = self.hierarchy(at & ASLEEP != 0);
+                        h.set(Slot(at & !ASLEEP), &b);
+                    }
+                }
+                b
+            } else {
+                pairs.refused.push(id);
+                if self.at[id as usize] != PARKED {
+                    self.take_out(id);
+                    self.at[id as usize] = PARKED;
+                }
+                Aabb3::EMPTY
+            };
+            changes.push(Change { id, old, new });
+        }
+        for c in p {
+            changes.push(Change {
+                new: self.current(c.id),
+                ..*c
+            });
+        }
+        for c in &pending {
+            self.mark[c.id as usize] = 0;
+        }
+        pending.clear();
+        self.pending = pending;
+        for (i, c) in changes.iter().enumerate() {
+            self.mark[c.id as usize] = i as u32 + 1;
+        }
+
+        let ended = pairs.ended_wanted;
+        let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
+        let (awake, asleep, mark) = (&self.awake, &self.asleep, &self.mark[..]);
+        let stack = &mut self.stack;
+        crate::simd::plain(
+            #[inline(always)]
+            || {
+                search(&changes, [awake, asleep], mark, stack, begun);
+                if ended {
+                    search_ended(&changes, [awake, asleep], mark, stack, ended_pairs);
+                }
+            },
+        );
+        for c in &changes {
+            self.mark[c.id as usize] = 0;
+        }
+        self.changes = changes;
+    }
+}
+
+/// The begun pairs: each changed proxy's new box against both hierarchies. A pair of two
+/// changed proxies is taken from the larger id's query, and began when their old boxes did
+/// not overlap; a pair with an unchanged proxy began when the changed one's old box did not
+/// overlap the other's (unchanged) box.
+#[inline(always)]
+fn search(
+    changes: &[Change],
+    hierarchies: [&Hierarchy; 2],
+    mark: &[u32],
+    stack: &mut Vec<u32>,
+    begun: &mut Vec<(u32, u32)>,
+) {
+    for c in changes {
+        if c.new.min.x > c.new.max.x {
+            continue;
+        }
+        for h in hierarchies {
+            h.query(&c.new, stack, |other, b| {
+                if other == c.id {
+                    return;
+                }
+                let was = match mark[other as usize] {
+                    0 => overlap(&c.old, b),
+                    m if other < c.id => overlap(&c.old, &changes[m as usize - 1].old),
+                    _ => return,
+                };
+                if !was {
+                    begun.push((c.id.min(other), c.id.max(other)));
+                }
+            });
+        }
+    }
+}
+
+/// The ended pairs: each changed proxy's old box against both hierarchies for the unchanged
+/// proxies (whose boxes are as they were), and a sweep over the old boxes of the changed
+/// ones for the pairs of two changed proxies.
+#[inline(always)]
+fn search_ended(
+    changes: &[Change],
+    hierarchies: [&Hierarchy; 2],
+    mark: &[u32],
+    stack: &mut Vec<u32>,
+    ended: &mut Vec<(u32, u32)>,
+) {
+    let mut olds: Vec<u32> = Vec::new();
+    for (i, c) in changes.iter().enumerate() {
+        if c.old.min.x > c.old.max.x {
+            continue;
+        }
+        olds.push(i as u32);
+        for h in hierarchies {
+            h.query(&c.old, stack, |other, b| {
+                if mark[other as usize] == 0 && !overlap(&c.new, b) {
+                    ended.push((c.id.min(other), c.id.max(other)));
+                }
+            });
+        }
+    }
+    olds.sort_unstable_by(|&a, &b| {
+        let (a, b) = (&changes[a as usize].old, &changes[b as usize].old);
+        a.min.x.total_cmp(&b.min.x)
+    });
+    for (k, &i) in olds.iter().enumerate() {
+        let a = &changes[i as usize];
+        for &j in &olds[k + 1..] {
+            let b = &changes[j as usize];
+            if b.old.min.x > a.old.max.x {
+                break;
+            }
+            if overlap(&a.old, &b.old) && !overlap(&a.new, &b.new) {
+                ended.push((a.id.min(b.id), a.id.max(b.id)));
+            }
+        }
+    }
+}

@@ -1,0 +1,388 @@
+//! One wide hierarchy: nodes of eight children whose boxes are stored in the parent as
+//! columns (eight `min.x`, then eight `min.y`, …), so that one query tests all eight
+//! children at once; a child is another node or a proxy (a leaf).
+//!
+//! **Containment.** A child's slot holds the exact union of its node's slots (a proxy's slot
+//! holds its box): boxes are combined with `min` and `max` only, which round nothing, and
+//! every change to a slot is carried to the root ([`Hierarchy::refit_up`]) until a parent's
+//! slot already equals the new union. So a query visits every proxy whose box it overlaps.
+
+use crate::aabb::Aabb3;
+use alloc::vec::Vec;
+use glam::Vec3A;
+
+/// Children per node.
+pub(crate) const WIDTH: usize = 8;
+/// No child, no parent.
+pub(crate) const NONE: u32 = u32::MAX;
+/// The bit of a child reference that marks a proxy.
+const LEAF: u32 = 1 << 31;
+
+/// A slot: node `index >> 3`, child `index & 7`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Slot(pub u32);
+
+impl Slot {
+    fn new(node: u32, child: usize) -> Self {
+        Slot(node << 3 | child as u32)
+    }
+    pub(crate) fn node(self) -> u32 {
+        self.0 >> 3
+    }
+    pub(crate) fn child(self) -> usize {
+        (self.0 & 7) as usize
+    }
+}
+
+/// Eight children: their boxes as columns, their references, and where this node sits in
+/// its parent. An empty slot holds the empty box (`+∞` below `−∞`), which overlaps nothing.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Node {
+    min: [[f32; WIDTH]; 3],
+    max: [[f32; WIDTH]; 3],
+    child: [u32; WIDTH],
+    parent: Slot,
+}
+
+impl Node {
+    fn new(parent: Slot) -> Self {
+        Self {
+            min: [[f32::INFINITY; WIDTH]; 3],
+            max: [[f32::NEG_INFINITY; WIDTH]; 3],
+            child: [NONE; WIDTH],
+            parent,
+        }
+    }
+
+    /// Child `k`'s box.
+    #[inline(always)]
+    pub(crate) fn get(&self, k: usize) -> Aabb3 {
+        Aabb3::new(
+            Vec3A::new(self.min[0][k], self.min[1][k], self.min[2][k]),
+            Vec3A::new(self.max[0][k], self.max[1][k], self.max[2][k]),
+        )
+    }
+
+    #[inline(always)]
+    fn set(&mut self, k: usize, b: &Aabb3) {
+        for a in 0..3 {
+            self.min[a][k] = b.min[a];
+            self.max[a][k] = b.max[a];
+        }
+    }
+
+    /// The union of the eight slots (empty slots add nothing).
+    #[inline(always)]
+    fn union(&self) -> Aabb3 {
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for a in 0..3 {
+            for k in 0..WIDTH {
+                lo[a] = lo[a].min(self.min[a][k]);
+                hi[a] = hi[a].max(self.max[a][k]);
+            }
+        }
+        Aabb3::new(Vec3A::from_array(lo), Vec3A::from_array(hi))
+    }
+
+    /// Bit `k` set when child `k`'s box overlaps `[lo, hi]` (closed boxes); a branch-free
+    /// loop over the columns, which compiles to a few vector compares.
+    #[inline(always)]
+    fn overlaps(&self, lo: &[f32; 3], hi: &[f32; 3]) -> u32 {
+        let mut bits = 0;
+        for k in 0..WIDTH {
+            let mut hit = true;
+            for a in 0..3 {
+                hit &= (lo[a] <= self.max[a][k]) & (self.min[a][k] <= hi[a]);
+            }
+            bits |= u32::from(hit) << k;
+        }
+        bits
+    }
+
+    fn free_child(&self) -> Option<usize> {
+        self.child.iter().position(|&c| c == NONE)
+    }
+}
+
+/// A reference to a child: a node, or a proxy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Child {
+    Node(u32),
+    Proxy(u32),
+}
+
+impl Child {
+    fn encode(self) -> u32 {
+        match self {
+            Child::Node(n) => n,
+            Child::Proxy(id) => id | LEAF,
+        }
+    }
+    fn decode(c: u32) -> Option<Self> {
+        match c {
+            NONE => None,
+            c if c & LEAF != 0 => Some(Child::Proxy(c & !LEAF)),
+            c => Some(Child::Node(c)),
+        }
+    }
+}
+
+/// The half surface area of a box: the cost of visiting it, up to a constant.
+#[inline(always)]
+pub(crate) fn area(b: &Aabb3) -> f32 {
+    let d = b.max - b.min;
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+/// True when the closed boxes share a point.
+#[inline(always)]
+pub(crate) fn overlap(a: &Aabb3, b: &Aabb3) -> bool {
+    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
+}
+
+/// A wide hierarchy; node 0 is the root and always exists.
+#[derive(Clone, Debug)]
+pub(crate) struct Hierarchy {
+    nodes: Vec<Node>,
+    free: Vec<u32>,
+}
+
+impl Default for Hierarchy {
+    fn default() -> Self {
+        Self {
+            nodes: alloc::vec![Node::new(Slot(NONE))],
+            free: Vec::new(),
+        }
+    }
+}
+
+/// Where a hierarchy's changes send each proxy: `place(id, slot)` after every move.
+pub(crate) trait Places {
+    fn place(&mut self, id: u32, slot: Slot);
+}
+
+impl Hierarchy {
+    /// The box of the proxy in `slot`.
+    pub(crate) fn get(&self, slot: Slot) -> Aabb3 {
+        self.nodes[slot.node() as usize].get(slot.child())
+    }
+
+    /// The number of nodes in use.
+    pub(crate) fn nodes(&self) -> usize {
+        self.nodes.len() - self.free.len()
+    }
+
+    fn alloc(&mut self, parent: Slot) -> u32 {
+        match self.free.pop() {
+            Some(n) => {
+                self.nodes[n as usize] = Node::new(parent);
+                n
+            }
+            None => {
+                self.nodes.push(Node::new(parent));
+                (self.nodes.len() - 1) as u32
+            }
+        }
+    }
+
+    /// Node `n`'s union into its parent's slot, and so on up while a slot changes.
+    pub(crate) fn refit_up(&mut self, mut n: u32) {
+        loop {
+            let node = &self.nodes[n as usize];
+            let parent = node.parent;
+            if parent.0 == NONE {
+                return;
+            }
+            let b = node.union();
+            let p = &mut self.nodes[parent.node() as usize];
+            if p.get(parent.child()) == b {
+                return;
+            }
+            p.set(parent.child(), &b);
+            n = parent.node();
+        }
+    }
+
+    /// Writes the box of the proxy in `slot` and refits above it.
+    pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
+        self.nodes[slot.node() as usize].set(slot.child(), b);
+        self.refit_up(slot.node());
+    }
+
+    /// Adds proxy `id` with box `b`: down from the root, into the first node with a free
+    /// slot, else into the child whose box grows least in area (a proxy there becomes a
+    /// node of two). Returns its slot.
+    pub(crate) fn insert(&mut self, id: u32, b: &Aabb3, places: &mut impl Places) -> Slot {
+        let mut n = 0u32;
+        loop {
+            let node = &self.nodes[n as usize];
+            if let Some(k) = node.free_child() {
+                let node = &mut self.nodes[n as usize];
+                node.set(k, b);
+                node.child[k] = Child::Proxy(id).encode();
+                self.refit_up(n);
+                let slot = Slot::new(n, k);
+                places.place(id, slot);
+                return slot;
+            }
+            let mut best = (f32::INFINITY, f32::INFINITY, 0);
+            for k in 0..WIDTH {
+                let c = node.get(k);
+                let grown = area(&c.union(b)) - area(&c);
+                let key = (grown, area(&c), k);
+                if key.0 < best.0 || (key.0 == best.0 && key.1 < best.1) {
+                    best = key;
+                }
+            }
+            // An area of ±∞ or NaN (boxes near `f32::MAX`) compares false: child 0.
+            let k = best.2;
+            match Child::decode(node.child[k]) {
+                Some(Child::Node(c)) => n = c,
+                Some(Child::Proxy(other)) => {
+                    let old = node.get(k);
+                    let m = self.alloc(Slot::new(n, k));
+                    let node = &mut self.nodes[m as usize];
+                    node.set(0, &old);
+                    node.child[0] = Child::Proxy(other).encode();
+                    self.nodes[n as usize].child[k] = Child::Node(m).encode();
+                    places.place(other, Slot::new(m, 0));
+                    n = m;
+                }
+                None => unreachable!("a node without a free slot has eight children"),
+            }
+        }
+    }
+
+    /// Takes the proxy in `slot` out; a node left empty leaves its parent, and the boxes
+    /// above shrink to what remains.
+    pub(crate) fn remove(&mut self, slot: Slot) {
+        let (mut n, mut k) = (slot.node(), slot.child());
+        loop {
+            let node = &mut self.nodes[n as usize];
+            node.child[k] = NONE;
+            node.set(k, &Aabb3::EMPTY);
+            if n == 0 || node.child.iter().any(|&c| c != NONE) {
+                self.refit_up(n);
+                return;
+            }
+            let parent = node.parent;
+            self.free.push(n);
+            (n, k) = (parent.node(), parent.child());
+        }
+    }
+
+    /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with `stack` as scratch.
+    #[inline(always)]
+    pub(crate) fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
+        let (lo, hi) = (q.min.to_array(), q.max.to_array());
+        stack.clear();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            let mut bits = node.overlaps(&lo, &hi);
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let c = node.child[k];
+                if c & LEAF != 0 {
+                    hit(c & !LEAF, &node.get(k));
+                } else {
+                    stack.push(c);
+                }
+            }
+        }
+    }
+
+    /// Every proxy and its box, in no particular order.
+    pub(crate) fn proxies(&self) -> Vec<(u32, Aabb3)> {
+        let mut out = Vec::new();
+        let mut stack = alloc::vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            for k in 0..WIDTH {
+                match Child::decode(node.child[k]) {
+                    Some(Child::Proxy(id)) => out.push((id, node.get(k))),
+                    Some(Child::Node(c)) => stack.push(c),
+                    None => {}
+                }
+            }
+        }
+        out
+    }
+
+    /// A new hierarchy over `items` (ids and boxes), split top-down at the median of the
+    /// widest spread of centres until every node has eight children: balanced, so its
+    /// depth is about `log8(n)` whatever the distribution. Every proxy's slot goes to
+    /// `places`.
+    pub(crate) fn build(items: &mut [(u32, Aabb3)], places: &mut impl Places) -> Self {
+        let mut h = Self {
+            nodes: Vec::with_capacity(items.len() / 6 + 1),
+            free: Vec::new(),
+        };
+        h.nodes.push(Node::new(Slot(NONE)));
+        h.fill(0, items, places);
+        h
+    }
+
+    /// Fills node `n` with `items`; returns its union.
+    fn fill(&mut self, n: u32, items: &mut [(u32, Aabb3)], places: &mut impl Places) -> Aabb3 {
+        // Up to eight groups, each the split of the largest one at its median.
+        let mut groups = [(0usize, 0usize); WIDTH];
+        groups[0] = (0, items.len());
+        let mut count = usize::from(!items.is_empty());
+        while count < WIDTH {
+            let Some((g, &(start, end))) = groups[..count]
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, (s, e))| e - s)
+            else {
+                break;
+            };
+            if end - start < 2 {
+                break;
+            }
+            let mid = start + (end - start) / 2;
+            split_at_median(&mut items[start..end], mid - start);
+            groups[g] = (start, mid);
+            groups[count] = (mid, end);
+            count += 1;
+        }
+        for (k, &(start, end)) in groups[..count].iter().enumerate() {
+            let (b, c) = if end - start == 1 {
+                let (id, b) = items[start];
+                places.place(id, Slot::new(n, k));
+                (b, Child::Proxy(id))
+            } else {
+                let m = self.alloc(Slot::new(n, k));
+                (self.fill(m, &mut items[start..end], places), Child::Node(m))
+            };
+            let node = &mut self.nodes[n as usize];
+            node.set(k, &b);
+            node.child[k] = c.encode();
+        }
+        self.nodes[n as usize].union()
+    }
+}
+
+/// Reorders `items` so that the first `mid` have the smallest centres along the axis where
+/// the centres spread widest.
+fn split_at_median(items: &mut [(u32, Aabb3)], mid: usize) {
+    let centre = |b: &Aabb3| b.min * 0.5 + b.max * 0.5;
+    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for (_, b) in items.iter() {
+        lo = lo.min(centre(b));
+        hi = hi.max(centre(b));
+    }
+    let spread = hi - lo;
+    let axis = if spread.x >= spread.y && spread.x >= spread.z {
+        0
+    } else if spread.y >= spread.z {
+        1
+    } else {
+        2
+    };
+    items.select_nth_unstable_by(mid, |a, b| {
+        centre(&a.1)[axis].total_cmp(&centre(&b.1)[axis])
+    });
+}

@@ -1,0 +1,319 @@
+//! The broadphase's dynamic tree against a brute-force all-pairs reference: over many frames
+//! of a dense random walk fed by `Batch::update`, with islands going to sleep and waking,
+//! bodies removed and inserted and full rebuilds, the begun and ended pairs of every frame
+//! are exactly the differences of the brute-force pair sets; and its refusals of bad input.
+
+use std::collections::BTreeSet;
+
+use bvkit::broadphase::{BroadphaseError, DynamicTree, Pairs};
+use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
+use glam::{Quat, Vec3A};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+
+type Set = BTreeSet<(u32, u32)>;
+
+/// Every pair of overlapping closed boxes among the members, by brute force.
+fn brute_force(boxes: &[Aabb3], member: &[bool]) -> Set {
+    let overlap = |a: &Aabb3, b: &Aabb3| a.min.cmple(b.max).all() && b.min.cmple(a.max).all();
+    let mut set = Set::new();
+    for i in 0..boxes.len() {
+        for j in i + 1..boxes.len() {
+            if member[i] && member[j] && overlap(&boxes[i], &boxes[j]) {
+                set.insert((i as u32, j as u32));
+            }
+        }
+    }
+    set
+}
+
+/// The pairs as a set, with a check that none is listed twice or out of order.
+fn as_set(pairs: &[(u32, u32)]) -> Set {
+    let set: Set = pairs.iter().copied().collect();
+    assert_eq!(set.len(), pairs.len(), "a pair is reported twice");
+    assert!(
+        pairs.iter().all(|(a, b)| a < b),
+        "a pair is not (smaller, larger)"
+    );
+    set
+}
+
+/// Checks one frame's report against the reference: begun = now \ before, ended = before \ now.
+fn check(frame: usize, pairs: &Pairs, before: &Set, now: &Set, tree: &DynamicTree) {
+    let begun: Set = now.difference(before).copied().collect();
+    let ended: Set = before.difference(now).copied().collect();
+    assert_eq!(as_set(&pairs.begun), begun, "frame {frame}: begun pairs");
+    assert_eq!(as_set(&pairs.ended), ended, "frame {frame}: ended pairs");
+    let all: Set = tree.overlapping_pairs().into_iter().collect();
+    assert_eq!(&all, now, "frame {frame}: all overlapping pairs");
+}
+
+#[test]
+fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
+    const N: usize = 400;
+    const ISLAND: usize = 16;
+    let mut r = StdRng::seed_from_u64(47);
+    // Boxes of 0.2 to 1 unit in a cube of 12 units: about six overlaps per body.
+    let local: Vec<Aabb3> = (0..N)
+        .map(|_| {
+            let e = Vec3A::new(
+                r.random_range(0.1..0.5),
+                r.random_range(0.1..0.5),
+                r.random_range(0.1..0.5),
+            );
+            Aabb3::new(-e, e)
+        })
+        .collect();
+    let mut poses: Vec<Rigid3> = (0..N)
+        .map(|_| {
+            let p = Vec3A::new(
+                r.random_range(-6.0..6.0),
+                r.random_range(-6.0..6.0),
+                r.random_range(-6.0..6.0),
+            );
+            Rigid3::new(Quat::from_rotation_x(r.random_range(0.0..6.0)), p)
+        })
+        .collect();
+    let velocity: Vec<Vec3A> = (0..N)
+        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 0.6 - 0.3)
+        .collect();
+    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+    let margin = Margin::new(0.05, 0.1);
+    let (mut fat, mut moved) = (vec![Aabb3::EMPTY; N], Moved::new());
+    batch
+        .update(margin, Active::All, &local, &poses, &mut fat, &mut moved)
+        .unwrap();
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut member = vec![true; N];
+    let mut awake = vec![true; N];
+    let mut before = Set::new();
+    let mut pairs = Pairs::with_ended();
+    let (mut begun, mut ended, mut slept, mut removed) = (0, 0, 0, 0);
+    for frame in 0..120 {
+        // Islands fall asleep and wake; the update then skips the sleeping bodies.
+        for start in (0..N).step_by(ISLAND) {
+            let ids: Vec<u32> = (start as u32..(start + ISLAND) as u32).collect();
+            if r.random_bool(0.1) {
+                let sleep = awake[start];
+                if sleep {
+                    tree.sleep(&ids);
+                    slept += 1;
+                } else {
+                    tree.wake(&ids);
+                }
+                for &i in &ids {
+                    awake[i as usize] = !sleep;
+                    if member[i as usize] {
+                        assert_eq!(tree.is_asleep(i), sleep);
+                    }
+                }
+            }
+        }
+        // Bodies leave and come back between updates.
+        for _ in 0..3 {
+            let i = r.random_range(0..N);
+            if member[i] {
+                assert!(tree.remove(i as u32));
+                removed += 1;
+            } else {
+                tree.insert(i as u32, fat[i]).unwrap();
+            }
+            member[i] = !member[i];
+        }
+        for i in 0..N {
+            if awake[i] {
+                poses[i].translation += velocity[i];
+                // Keep the walk dense: bounce off the cube's walls.
+                let t = poses[i].translation;
+                poses[i].translation = t.clamp(Vec3A::splat(-6.0), Vec3A::splat(6.0));
+                poses[i].rotation = Quat::from_rotation_y(0.1) * poses[i].rotation;
+            }
+        }
+        let mut mask = vec![0u64; N.div_ceil(64)];
+        for i in 0..N {
+            if awake[i] {
+                mask[i / 64] |= 1 << (i % 64);
+            }
+        }
+        batch
+            .update(
+                margin,
+                Active::Mask(&mask),
+                &local,
+                &poses,
+                &mut fat,
+                &mut moved,
+            )
+            .unwrap();
+        if frame % 25 == 24 {
+            tree.rebuild();
+        }
+        tree.update(moved.indices(), &fat, &mut pairs).unwrap();
+        let now = brute_force(&fat, &member);
+        check(frame, &pairs, &before, &now, &tree);
+        assert!(pairs.refused.is_empty());
+        for i in 0..N {
+            assert_eq!(
+                tree.get(i as u32),
+                member[i].then_some(fat[i]),
+                "frame {frame}"
+            );
+        }
+        begun += pairs.begun.len();
+        ended += pairs.ended.len();
+        before = now;
+    }
+    // The walk exercised what it claims to.
+    assert!(begun > 1000 && ended > 1000, "begun {begun}, ended {ended}");
+    assert!(
+        slept > 10 && removed > 50,
+        "slept {slept}, removed {removed}"
+    );
+    assert!(before.len() > 300, "{} pairs at the end", before.len());
+}
+
+#[test]
+fn begun_pairs_alone_match_the_reference() {
+    // Without the ended pairs (the default), the begun ones are the same.
+    let boxes = |shift: f32| -> Vec<Aabb3> {
+        (0..64)
+            .map(|i| {
+                let c = Vec3A::new((i % 8) as f32, (i / 8) as f32, 0.0) + Vec3A::X * shift;
+                Aabb3::new(c - 0.3, c + 0.3)
+            })
+            .collect()
+    };
+    let start = boxes(0.0);
+    let mut tree = DynamicTree::from_boxes(&start).unwrap();
+    let mut pairs = Pairs::new();
+    let member = vec![true; 64];
+    tree.update(&[], &start, &mut pairs).unwrap();
+    assert!(pairs.begun.is_empty() && pairs.ended.is_empty());
+    // Every odd body moves half a unit along x: it now touches its neighbours.
+    let mut next = start.clone();
+    let odd: Vec<u32> = (1..64).step_by(2).collect();
+    for &i in &odd {
+        next[i as usize] = boxes(0.5)[i as usize];
+    }
+    tree.update(&odd, &next, &mut pairs).unwrap();
+    let now = brute_force(&next, &member);
+    assert!(!now.is_empty());
+    assert_eq!(as_set(&pairs.begun), now);
+    assert!(pairs.ended.is_empty());
+}
+
+#[test]
+fn the_first_update_begins_every_overlapping_pair() {
+    let b = |x: f32| Aabb3::new(Vec3A::new(x, 0.0, 0.0), Vec3A::new(x + 1.0, 1.0, 1.0));
+    let fat = vec![b(0.0), b(1.0), b(2.0), b(10.0)];
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    // Touching faces overlap (closed boxes).
+    assert_eq!(as_set(&pairs.begun), Set::from([(0, 1), (1, 2)]));
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    assert!(pairs.begun.is_empty() && pairs.ended.is_empty());
+}
+
+#[test]
+fn bad_boxes_are_refused_at_insert() {
+    let good = Aabb3::new(Vec3A::ZERO, Vec3A::ONE);
+    let mut tree = DynamicTree::new();
+    tree.insert(0, good).unwrap();
+    for bad in [
+        Aabb3::NAN,
+        Aabb3::EMPTY,
+        Aabb3::new(Vec3A::ZERO, Vec3A::new(1.0, f32::NAN, 1.0)),
+        Aabb3::new(Vec3A::ZERO, Vec3A::new(f32::INFINITY, 1.0, 1.0)),
+        Aabb3::new(Vec3A::ONE, Vec3A::ZERO),
+    ] {
+        assert_eq!(
+            tree.insert(1, bad),
+            Err(BroadphaseError::InvalidBox { id: 1 })
+        );
+        assert!(!tree.contains(1));
+        assert_eq!(
+            DynamicTree::from_boxes(&[good, bad][..]).err(),
+            Some(BroadphaseError::InvalidBox { id: 1 })
+        );
+    }
+    assert_eq!(
+        tree.insert(0, good),
+        Err(BroadphaseError::Duplicate { id: 0 })
+    );
+    assert_eq!(
+        tree.insert(u32::MAX, good),
+        Err(BroadphaseError::IdTooLarge { id: u32::MAX })
+    );
+    assert_eq!(tree.len(), 1);
+    // Nothing reached the tree: it still answers.
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &[good][..], &mut pairs).unwrap();
+    assert!(pairs.begun.is_empty() && pairs.refused.is_empty());
+}
+
+#[test]
+fn a_bad_box_at_update_parks_its_proxy_until_a_good_one_comes() {
+    let b = |x: f32| Aabb3::new(Vec3A::new(x, 0.0, 0.0), Vec3A::new(x + 1.0, 1.0, 1.0));
+    let mut fat = vec![b(0.0), b(0.5), b(5.0)];
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    assert_eq!(pairs.begun, [(0, 1)]);
+    for bad in [
+        Aabb3::NAN,
+        Aabb3::new(Vec3A::splat(f32::NEG_INFINITY), Vec3A::ONE),
+    ] {
+        fat[1] = bad;
+        tree.update(&[1], &fat, &mut pairs).unwrap();
+        // Refused and reported; its pair ends; it is out of every query.
+        assert_eq!(pairs.refused, [1]);
+        assert_eq!(pairs.ended, [(0, 1)]);
+        assert!(tree.is_parked(1) && tree.contains(1) && tree.get(1).is_none());
+        let mut hits = vec![];
+        tree.query(&Aabb3::new(Vec3A::splat(-1e30), Vec3A::splat(1e30)), |id| {
+            hits.push(id)
+        });
+        hits.sort();
+        assert_eq!(hits, [0, 2]);
+        // A rebuild and another bad box change nothing.
+        tree.rebuild();
+        tree.update(&[1], &fat, &mut pairs).unwrap();
+        assert_eq!(pairs.refused, [1]);
+        assert!(pairs.begun.is_empty() && pairs.ended.is_empty());
+        // A good box brings it back, and its pair begins again.
+        fat[1] = b(0.5);
+        tree.update(&[1], &fat, &mut pairs).unwrap();
+        assert!(pairs.refused.is_empty());
+        assert_eq!(pairs.begun, [(0, 1)]);
+        assert_eq!(tree.get(1), Some(b(0.5)));
+    }
+    // A parked proxy can be removed.
+    fat[2] = Aabb3::NAN;
+    tree.update(&[2], &fat, &mut pairs).unwrap();
+    assert!(tree.remove(2) && !tree.contains(2));
+    assert_eq!(tree.len(), 2);
+}
+
+#[test]
+fn bad_moved_lists_are_errors_before_any_change() {
+    let b = Aabb3::new(Vec3A::ZERO, Vec3A::ONE);
+    let fat = vec![b; 3];
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut pairs = Pairs::new();
+    assert_eq!(
+        tree.update(&[1, 0], &fat, &mut pairs),
+        Err(BroadphaseError::Unsorted)
+    );
+    assert_eq!(
+        tree.update(&[1, 1], &fat, &mut pairs),
+        Err(BroadphaseError::Unsorted)
+    );
+    assert_eq!(
+        tree.update(&[3], &fat, &mut pairs),
+        Err(BroadphaseError::MissingBox { id: 3, len: 3 })
+    );
+    // The pending first frame is still there.
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    assert_eq!(as_set(&pairs.begun), Set::from([(0, 1), (0, 2), (1, 2)]));
+}
