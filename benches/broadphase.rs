@@ -265,6 +265,7 @@ fn pipelines(c: &mut Criterion) {
             ("A", bvh::Tuning::default(), 0),
             ("B", bvh::Tuning::default(), 1),
             ("B-relative-0.3", relative, 1),
+            ("C", bvh::Tuning::default(), 2),
         ] {
             for (k, stage) in STAGES.iter().enumerate() {
                 // Every benchmark from the same first frame, so that each one times the
@@ -278,7 +279,7 @@ fn pipelines(c: &mut Criterion) {
                         for _ in 0..iters {
                             scene.step();
                             let frames = pipelines.frame(&scene);
-                            let f = [frames.0, frames.1][pick];
+                            let f = frames[pick];
                             ms += f.ms.get(k).copied().unwrap_or_else(|| f.total());
                         }
                         Duration::from_secs_f64(ms / 1e3)

@@ -10,7 +10,12 @@
 //!   promises in each layout: every fat box contains its body's tight box.
 //! - `cargo run --release --features peers --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
 //!   [--partial K]`: two whole broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage
-//!   by stage; the options tune bvkit's pipeline.
+//!   by stage; the options tune bvkit's pipeline. A third pipeline, C, runs bvkit's update
+//!   into bvkit's own `broadphase::DynamicTree`.
+//! - `cargo run --release --features peers --example broadphase tree [T]`: the three
+//!   pipelines on the two scenes of issue 47 (1M bodies half asleep, 100K all awake), T
+//!   frames each (default 10), C's begun pairs checked every frame against a sweep; the
+//!   last line reads `frame_vs_rapier_1m=R1 frame_vs_rapier_100k=R2 missing_pairs=M`.
 
 use bvkit_support::broadphase::{bvh, scene};
 use bvkit_support::common;
@@ -23,8 +28,11 @@ use scene::Scene;
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let pipelines = args.first().is_some_and(|a| a == "bvh");
-    if pipelines {
+    let mode = args
+        .first()
+        .filter(|a| *a == "bvh" || *a == "tree")
+        .cloned();
+    if mode.is_some() {
         args.remove(0);
     }
     // `--name value`, taken out of the positional arguments.
@@ -44,14 +52,35 @@ fn main() {
     };
     let (n, frames, asleep) = (arg(0, 1e6) as usize, arg(1, 30.0) as usize, arg(2, 0.5));
     let island = (arg(3, 256.0) as usize).max(1);
-    if pipelines {
-        bvh::run(n, frames, asleep, island, tuning);
+    if mode.as_deref() == Some("tree") {
+        tree(arg(0, 10.0) as usize, tuning);
+    } else if mode.is_some() {
+        bvh::run(n, frames, asleep, island, tuning, false);
     } else {
         update_against_naive(n, frames, asleep, island);
     }
 }
 
 /// The fat-box update against the naive pass, in AoS and AoSoA.
+/// The issue's two scenes through the three pipelines, C's reports checked every frame;
+/// the last line gives C's frame against A's in each and the pairs C missed.
+fn tree(frames: usize, tuning: bvh::Tuning) {
+    let big = bvh::run(1_000_000, frames, 0.5, 256, tuning, true);
+    println!();
+    let small = bvh::run(100_000, frames, 0.0, 256, tuning, true);
+    assert_eq!(
+        big.wrong + small.wrong,
+        0,
+        "C reported a pair that did not begin"
+    );
+    println!(
+        "frame_vs_rapier_1m={:.2} frame_vs_rapier_100k={:.2} missing_pairs={}",
+        big.frame[2] / big.frame[0],
+        small.frame[2] / small.frame[0],
+        big.missing + small.missing
+    );
+}
+
 fn update_against_naive(n: usize, frames: usize, asleep: f64, island: usize) {
     let mut scene = Scene::new(n, asleep, island);
     let (awake, mask, local) = (scene.awake, scene.mask.clone(), scene.local.clone());

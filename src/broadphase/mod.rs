@@ -39,7 +39,7 @@
 //! ```
 //!
 //! **What a frame reports.** Between two updates, a pair's overlap *begins* when the two fat
-//! boxes overlap now (closed boxes: touching counts) and did not at the last update, and
+//! boxes overlap now (closed boxes: touching counts) and did not at the last report, and
 //! *ends* the other way round; a body inserted, removed or parked since counts as having
 //! had, or having, no box. This is exact: the tree loses no pair and invents none, whatever
 //! moved, because its node boxes are exact unions (`min`/`max` round nothing), and the
@@ -60,6 +60,7 @@ use crate::aabb::Aabb3;
 use crate::layout::BoxSource;
 use alloc::vec::Vec;
 use core::fmt;
+use core::mem::take;
 use wide::{Hierarchy, Places, Slot, overlap};
 
 /// Why the tree refused an input.
@@ -119,12 +120,13 @@ impl core::error::Error for BroadphaseError {}
 /// once; the order of the pairs is deterministic but unspecified.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Pairs {
-    /// The pairs whose fat boxes overlap now and did not at the last update.
+    /// The pairs whose fat boxes overlap now and did not at the last report.
     pub begun: Vec<(u32, u32)>,
-    /// The pairs whose fat boxes overlapped at the last update and do not now (filled only
+    /// The pairs whose fat boxes overlapped at the last report and do not now (filled only
     /// when made by [`Pairs::with_ended`]).
     pub ended: Vec<(u32, u32)>,
-    /// Moved proxies whose new box was refused (NaN, infinite or inverted), now parked.
+    /// Moved proxies whose new box was refused (NaN, infinite or inverted) since the last
+    /// report, now parked.
     pub refused: Vec<u32>,
     ended_wanted: bool,
 }
@@ -159,7 +161,7 @@ const ASLEEP: u32 = 1 << 31;
 /// Ids are packed in 31 bits, with the two codes above kept out of range.
 const MAX_ID: u32 = (1 << 31) - 2;
 
-/// A proxy whose box changed since the last update: its box then and now (the empty box
+/// A proxy whose box changed since the last report: its box then and now (the empty box
 /// when it had, or has, none).
 #[derive(Clone, Copy, Debug)]
 struct Change {
@@ -193,14 +195,17 @@ pub struct DynamicTree {
     asleep: Hierarchy,
     /// Per id: [`ABSENT`], [`PARKED`], or a slot (with [`ASLEEP`] in the asleep hierarchy).
     at: Vec<u32>,
-    /// Per id: 1 + its index in `changes` (during an update) or in `pending` (between
-    /// updates), 0 when it is in neither.
+    /// Per id: 1 + its index in `pending`, 0 when it has not changed since the last report.
     mark: Vec<u32>,
-    /// Proxies inserted, removed or parked since the last update, each with its box then.
+    /// Proxies written, inserted, removed or parked since the last report, each with its
+    /// box then.
     pending: Vec<Change>,
+    /// Proxies refused since the last report.
+    refused: Vec<u32>,
     len: usize,
-    changes: Vec<Change>,
+    /// Scratch: the moved boxes, an order of them or of the changes, the query stack.
     fresh: Vec<(u32, Aabb3)>,
+    order: Vec<u64>,
     stack: Vec<u32>,
 }
 
@@ -212,7 +217,7 @@ impl DynamicTree {
     }
 
     /// A tree whose proxy `i` is awake with box `i` of `fat`, built balanced (as
-    /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first update.
+    /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first report.
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for the first NaN, infinite or inverted box,
@@ -315,8 +320,8 @@ impl DynamicTree {
         self.get(id).unwrap_or(Aabb3::EMPTY)
     }
 
-    /// Notes that `id`'s box is about to change outside an update (its box at the last
-    /// update is the one it has now, unless it already changed since).
+    /// Notes that `id`'s box is about to change (its box at the last report is the one it
+    /// has now, unless it already changed since).
     fn note(&mut self, id: u32) {
         if self.mark[id as usize] == 0 {
             let old = self.current(id);
@@ -358,7 +363,7 @@ impl DynamicTree {
         h.insert(id, b, &mut places);
     }
 
-    /// Adds proxy `id` (awake) with fat box `fat`; its pairs begin at the next update.
+    /// Adds proxy `id` (awake) with fat box `fat`; its pairs begin at the next report.
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
@@ -378,7 +383,7 @@ impl DynamicTree {
         Ok(())
     }
 
-    /// Removes proxy `id`; its pairs end at the next update. Returns false when it was not
+    /// Removes proxy `id`; its pairs end at the next report. Returns false when it was not
     /// in the tree.
     pub fn remove(&mut self, id: u32) -> bool {
         if !self.contains(id) {
@@ -454,21 +459,31 @@ impl DynamicTree {
         out
     }
 
-    /// One frame: the proxies in `moved` (strictly ascending ids, as
-    /// [`Moved::indices`](crate::Moved::indices)) take their boxes from `fat` (indexed by id,
-    /// in any box layout the batch writes); then `pairs` receives the pairs that began (and
-    /// ended) since the last update, the inserts and removes since then included. Moved ids
-    /// not in the tree are ignored; a refused box parks its proxy (module docs).
+    /// One frame: [`DynamicTree::write`] then [`DynamicTree::report`].
     ///
     /// # Errors
-    /// [`BroadphaseError::Unsorted`], [`BroadphaseError::MissingBox`] or
-    /// [`BroadphaseError::Layout`], before anything changes.
+    /// As [`DynamicTree::write`], before anything changes.
     pub fn update(
         &mut self,
         moved: &[u32],
         fat: impl BoxSource<3>,
         pairs: &mut Pairs,
     ) -> Result<(), BroadphaseError> {
+        self.write(moved, fat)?;
+        self.report(pairs);
+        Ok(())
+    }
+
+    /// The tree's half of a frame: the proxies in `moved` (strictly ascending ids, as
+    /// [`Moved::indices`](crate::Moved::indices)) take their boxes from `fat` (indexed by id,
+    /// in any box layout the batch writes), and each change is carried up the tree while a
+    /// parent's box changes. Moved ids not in the tree are ignored; a refused box parks its
+    /// proxy (module docs). The pairs wait for [`DynamicTree::report`].
+    ///
+    /// # Errors
+    /// [`BroadphaseError::Unsorted`], [`BroadphaseError::MissingBox`] or
+    /// [`BroadphaseError::Layout`], before anything changes.
+    pub fn write(&mut self, moved: &[u32], fat: impl BoxSource<3>) -> Result<(), BroadphaseError> {
         if !moved.is_sorted_by(|a, b| a < b) {
             return Err(BroadphaseError::Unsorted);
         }
@@ -478,73 +493,63 @@ impl DynamicTree {
         {
             return Err(BroadphaseError::MissingBox { id, len });
         }
-        let mut fresh = core::mem::take(&mut self.fresh);
-        fresh.clear();
+        // The boxes read in id order, then written in slot order: the build lays nodes out
+        // depth first, so the writes sweep the nodes instead of jumping between them.
+        let (mut fresh, mut order) = (take(&mut self.fresh), take(&mut self.order));
+        (fresh.clear(), order.clear());
         for &id in moved {
-            if self.contains(id) {
+            if let Some(&at) = self.at.get(id as usize)
+                && at != ABSENT
+            {
                 let (min, max) = fat.get(id as usize);
+                order.push(u64::from(at) << 32 | fresh.len() as u64);
                 fresh.push((id, Aabb3::new(min.into(), max.into())));
             }
         }
-        self.frame(&fresh, pairs);
-        self.fresh = fresh;
+        order.sort_unstable();
+        for &key in &order {
+            let (id, b) = fresh[key as u32 as usize];
+            self.set(id, &b);
+        }
+        (self.fresh, self.order) = (fresh, order);
         Ok(())
     }
 
-    /// [`DynamicTree::update`] once the moved proxies' boxes are read (`fresh`, ascending).
-    fn frame(&mut self, fresh: &[(u32, Aabb3)], pairs: &mut Pairs) {
-        pairs.clear();
-        let mut changes = core::mem::take(&mut self.changes);
-        changes.clear();
-        // The changes: the moved proxies merged with the pending ones, ascending.
-        let mut pending = core::mem::take(&mut self.pending);
-        pending.sort_unstable_by_key(|c| c.id);
-        let mut p = pending.iter().peekable();
-        for &(id, b) in fresh {
-            while let Some(c) = p.next_if(|c| c.id < id) {
-                changes.push(Change {
-                    new: self.current(c.id),
-                    ..*c
-                });
-            }
-            let old = match p.next_if(|c| c.id == id) {
-                Some(c) => c.old,
-                None => self.current(id),
-            };
-            let new = if accepts(&b) {
-                match self.at[id as usize] {
-                    PARKED => self.place(id, &b, false),
-                    at => {
-                        let (h, _) = self.hierarchy(at & ASLEEP != 0);
-                        h.set(Slot(at & !ASLEEP), &b);
-                    }
-                }
-                b
+    /// Gives proxy `id` (in the tree) box `b`, or parks it when `b` is refused.
+    fn set(&mut self, id: u32, b: &Aabb3) {
+        self.note(id);
+        let at = self.at[id as usize];
+        if accepts(b) {
+            if at == PARKED {
+                self.place(id, b, false);
             } else {
-                pairs.refused.push(id);
-                if self.at[id as usize] != PARKED {
-                    self.take_out(id);
-                    self.at[id as usize] = PARKED;
-                }
-                Aabb3::EMPTY
-            };
-            changes.push(Change { id, old, new });
+                let (h, _) = self.hierarchy(at & ASLEEP != 0);
+                h.set(Slot(at & !ASLEEP), b);
+            }
+        } else {
+            self.refused.push(id);
+            if at != PARKED {
+                self.take_out(id);
+                self.at[id as usize] = PARKED;
+            }
         }
-        for c in p {
-            changes.push(Change {
-                new: self.current(c.id),
-                ..*c
-            });
-        }
-        for c in &pending {
-            self.mark[c.id as usize] = 0;
-        }
-        pending.clear();
-        self.pending = pending;
-        for (i, c) in changes.iter().enumerate() {
-            self.mark[c.id as usize] = i as u32 + 1;
-        }
+    }
 
+    /// The pairs' half of a frame: `pairs` receives the pairs that began (and ended) since
+    /// the last report, searched from the proxies written, inserted, removed or parked
+    /// since, and the proxies refused since.
+    pub fn report(&mut self, pairs: &mut Pairs) {
+        pairs.clear();
+        core::mem::swap(&mut pairs.refused, &mut self.refused);
+        let mut changes = take(&mut self.pending);
+        let mut order = take(&mut self.order);
+        order.clear();
+        for (i, c) in changes.iter_mut().enumerate() {
+            c.new = self.current(c.id);
+            order.push(u64::from(self.at[c.id as usize]) << 32 | i as u64);
+        }
+        // Queries in slot order: neighbours in the tree share their paths in the caches.
+        order.sort_unstable();
         let ended = pairs.ended_wanted;
         let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
         let (awake, asleep, mark) = (&self.awake, &self.asleep, &self.mark[..]);
@@ -552,16 +557,17 @@ impl DynamicTree {
         crate::simd::plain(
             #[inline(always)]
             || {
-                search(&changes, [awake, asleep], mark, stack, begun);
+                search(&changes, &order, [awake, asleep], mark, stack, begun);
                 if ended {
-                    search_ended(&changes, [awake, asleep], mark, stack, ended_pairs);
+                    search_ended(&changes, &order, [awake, asleep], mark, stack, ended_pairs);
                 }
             },
         );
         for c in &changes {
             self.mark[c.id as usize] = 0;
         }
-        self.changes = changes;
+        changes.clear();
+        (self.pending, self.order) = (changes, order);
     }
 }
 
@@ -572,12 +578,14 @@ impl DynamicTree {
 #[inline(always)]
 fn search(
     changes: &[Change],
+    order: &[u64],
     hierarchies: [&Hierarchy; 2],
     mark: &[u32],
     stack: &mut Vec<u32>,
     begun: &mut Vec<(u32, u32)>,
 ) {
-    for c in changes {
+    for &key in order {
+        let c = &changes[key as u32 as usize];
         if c.new.min.x > c.new.max.x {
             continue;
         }
@@ -605,13 +613,16 @@ fn search(
 #[inline(always)]
 fn search_ended(
     changes: &[Change],
+    order: &[u64],
     hierarchies: [&Hierarchy; 2],
     mark: &[u32],
     stack: &mut Vec<u32>,
     ended: &mut Vec<(u32, u32)>,
 ) {
     let mut olds: Vec<u32> = Vec::new();
-    for (i, c) in changes.iter().enumerate() {
+    for &key in order {
+        let i = key as u32 as usize;
+        let c = &changes[i];
         if c.old.min.x > c.old.max.x {
             continue;
         }

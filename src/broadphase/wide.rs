@@ -2,10 +2,11 @@
 //! columns (eight `min.x`, then eight `min.y`, …), so that one query tests all eight
 //! children at once; a child is another node or a proxy (a leaf).
 //!
-//! **Containment.** A child's slot holds the exact union of its node's slots (a proxy's slot
-//! holds its box): boxes are combined with `min` and `max` only, which round nothing, and
-//! every change to a slot is carried to the root ([`Hierarchy::refit_up`]) until a parent's
-//! slot already equals the new union. So a query visits every proxy whose box it overlaps.
+//! **Containment.** A proxy's slot holds its box, and a node's slot in its parent contains
+//! the union of the node's slots: boxes are combined with `min` and `max` only, which round
+//! nothing, and a new box enlarges the slots above it until one already contains it
+//! ([`Hierarchy::set`]). So a query visits every proxy whose box it overlaps. Slots are
+//! exact unions after a build; moves leave them loose, never short.
 
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
@@ -186,28 +187,29 @@ impl Hierarchy {
         }
     }
 
-    /// Node `n`'s union into its parent's slot, and so on up while a slot changes.
-    pub(crate) fn refit_up(&mut self, mut n: u32) {
+    /// Writes the box of the proxy in `slot`, and enlarges the slots above it until one
+    /// already contains the box (Box2D's early exit): a slot's box then still contains its
+    /// node's union, with room left where a child shrank or left.
+    pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
+        self.nodes[slot.node() as usize].set(slot.child(), b);
+        self.enlarge_above(slot.node(), b);
+    }
+
+    /// Enlarges the slots above node `n` to contain `b`, up to the first that does.
+    fn enlarge_above(&mut self, mut n: u32, b: &Aabb3) {
         loop {
-            let node = &self.nodes[n as usize];
-            let parent = node.parent;
+            let parent = self.nodes[n as usize].parent;
             if parent.0 == NONE {
                 return;
             }
-            let b = node.union();
             let p = &mut self.nodes[parent.node() as usize];
-            if p.get(parent.child()) == b {
+            let old = p.get(parent.child());
+            if old.min.cmple(b.min).all() && b.max.cmple(old.max).all() {
                 return;
             }
-            p.set(parent.child(), &b);
+            p.set(parent.child(), &old.union(b));
             n = parent.node();
         }
-    }
-
-    /// Writes the box of the proxy in `slot` and refits above it.
-    pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
-        self.nodes[slot.node() as usize].set(slot.child(), b);
-        self.refit_up(slot.node());
     }
 
     /// Adds proxy `id` with box `b`: down from the root, into the first node with a free
@@ -221,7 +223,7 @@ impl Hierarchy {
                 let node = &mut self.nodes[n as usize];
                 node.set(k, b);
                 node.child[k] = Child::Proxy(id).encode();
-                self.refit_up(n);
+                self.enlarge_above(n, b);
                 let slot = Slot::new(n, k);
                 places.place(id, slot);
                 return slot;
@@ -254,8 +256,8 @@ impl Hierarchy {
         }
     }
 
-    /// Takes the proxy in `slot` out; a node left empty leaves its parent, and the boxes
-    /// above shrink to what remains.
+    /// Takes the proxy in `slot` out; a node left empty leaves its parent (the boxes above
+    /// keep their room until a rebuild).
     pub(crate) fn remove(&mut self, slot: Slot) {
         let (mut n, mut k) = (slot.node(), slot.child());
         loop {
@@ -263,7 +265,6 @@ impl Hierarchy {
             node.child[k] = NONE;
             node.set(k, &Aabb3::EMPTY);
             if n == 0 || node.child.iter().any(|&c| c != NONE) {
-                self.refit_up(n);
                 return;
             }
             let parent = node.parent;

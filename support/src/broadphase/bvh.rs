@@ -33,6 +33,7 @@
 use std::collections::HashSet;
 use std::time::Instant;
 
+use bvkit::broadphase::{DynamicTree, Pairs};
 use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3x8, Rounding};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
@@ -67,7 +68,9 @@ pub struct Tuning {
 /// The milliseconds of a frame's stages, and what they did.
 #[derive(Default, Clone, Copy)]
 pub struct Frame {
-    /// World or fat boxes, tree leaves, optimisation, refit, pairs.
+    /// World or fat boxes, tree leaves, optimisation, refit, pairs. C writes its leaves
+    /// and refits their paths in one step (its "leaves"), has no optimisation yet, and
+    /// reports the pairs that began.
     pub ms: [f64; 5],
     pub rewritten: usize,
     pub pairs: usize,
@@ -138,6 +141,16 @@ impl Tree {
     }
 }
 
+/// Pipeline C's state: the fat boxes and moved set of its update, and the tree.
+struct Dynamic {
+    fat: Vec<Aabb3x8>,
+    moved: Moved,
+    tree: DynamicTree,
+    pairs: Pairs,
+    /// The pairs of the tree's boxes at the last frame checked (the reference's).
+    checked: Option<HashSet<(u32, u32)>>,
+}
+
 fn ms(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
@@ -189,6 +202,8 @@ pub struct Pipelines {
     fat: Vec<Aabb3x8>,
     moved: Moved,
     b: Tree,
+    /// C: bvkit's update (its own fat boxes and moved set, as B's) into bvkit's tree.
+    c: Dynamic,
     tuning: Tuning,
     /// Frames run, and A's rewritten leaves in this one.
     frames: usize,
@@ -233,6 +248,17 @@ impl Pipelines {
         );
         let mut mask8 = scene.mask.clone();
         mask8.resize((8 * local8.len()).div_ceil(64), 0);
+        let mut tree = DynamicTree::from_boxes(&fat[..]).expect("finite fat boxes");
+        let mut pairs = Pairs::new();
+        // The first report: every overlapping pair begins.
+        tree.report(&mut pairs);
+        let c = Dynamic {
+            fat: fat.clone(),
+            moved: Moved::new(),
+            tree,
+            pairs,
+            checked: None,
+        };
         Self {
             local,
             poses,
@@ -246,14 +272,15 @@ impl Pipelines {
             fat,
             moved,
             b,
+            c,
             tuning,
             frames: 0,
             rewritten: Vec::new(),
         }
     }
 
-    /// One frame of each pipeline on the scene's current poses.
-    pub fn frame(&mut self, scene: &Scene) -> (Frame, Frame) {
+    /// One frame of each pipeline (A, B, C) on the scene's current poses.
+    pub fn frame(&mut self, scene: &Scene) -> [Frame; 3] {
         for i in scene.awake() {
             self.poses[i] = pose(&scene.poses[i]);
             self.poses8[i / 8].set(i % 8, scene.poses[i]);
@@ -306,17 +333,83 @@ impl Pipelines {
         let partial = self.tuning.partial;
         let whole = partial == 0 || self.frames.is_multiple_of(partial);
         self.b.finish(whole, self.moved.indices(), &mut fb);
-        (fa, fb)
+
+        let mut fc = Frame::default();
+        let c = &mut self.c;
+        let start = Instant::now();
+        self.batch
+            .update(
+                self.margin,
+                Active::Mask(&self.mask8),
+                &self.local8[..],
+                &self.poses8[..],
+                &mut c.fat[..],
+                &mut c.moved,
+            )
+            .expect("lengths agree");
+        fc.ms[0] = ms(start);
+        let start = Instant::now();
+        c.tree
+            .write(c.moved.indices(), &c.fat[..])
+            .expect("a sorted moved list");
+        fc.ms[1] = ms(start);
+        let start = Instant::now();
+        c.tree.report(&mut c.pairs);
+        fc.ms[4] = ms(start);
+        fc.rewritten = c.moved.len();
+        fc.pairs = c.pairs.begun.len();
+        [fa, fb, fc]
+    }
+
+    /// Checks C's last report against a sweep over its fat boxes: the pairs that began are
+    /// the pairs that overlap now and did not at the last check (which must be the last
+    /// frame). Returns the pairs missing from the report and the pairs it has wrongly.
+    pub fn check_c(&mut self, n: usize) -> (usize, usize) {
+        let c = &mut self.c;
+        let boxes: Vec<Aabb> = Aabb3x8::unpack(&c.fat, n).iter().map(parry_box).collect();
+        let now = overlapping(&boxes);
+        let Some(before) = c.checked.replace(now) else {
+            return (0, 0);
+        };
+        let now = c.checked.as_ref().expect("just set");
+        let begun: HashSet<(u32, u32)> = c.pairs.begun.iter().copied().collect();
+        let expected: HashSet<(u32, u32)> = now.difference(&before).copied().collect();
+        (
+            expected.difference(&begun).count(),
+            begun.difference(&expected).count(),
+        )
     }
 }
 
-pub fn run(n: usize, frames: usize, asleep: f64, island: usize, tuning: Tuning) {
+/// What a run measured: the mean frame of each pipeline (ms) and, over the frames checked,
+/// the pairs C's reports missed and had wrongly.
+pub struct Summary {
+    pub frame: [f64; 3],
+    pub missing: usize,
+    pub wrong: usize,
+    pub checked: usize,
+}
+
+/// Runs the scene through the three pipelines and prints every frame. `check` compares C's
+/// reports with a sweep over its fat boxes every frame (outside the timings); up to 20K
+/// bodies, every frame also checks that A's and B's trees keep every overlapping pair.
+pub fn run(
+    n: usize,
+    frames: usize,
+    asleep: f64,
+    island: usize,
+    tuning: Tuning,
+    check: bool,
+) -> Summary {
     let mut scene = Scene::new(n, asleep, island);
     let mut pipelines = Pipelines::new(&scene, tuning);
     // One frame before the measured ones: the first optimisation of a fresh tree costs
     // several frames' worth, once.
     scene.step();
     pipelines.frame(&scene);
+    if check {
+        pipelines.check_c(n);
+    }
     let verify = n <= 20_000;
     let batch = pipelines.batch;
     println!(
@@ -332,26 +425,32 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize, tuning: Tuning) 
     // The columns of each pipeline: its stages in `Frame::ms` order, then the totals.
     let columns = |first: &str| {
         [
-            first, "leaves", "optim", "refit", "pairs", "total", "rewrit",
+            first, "leaves", "optim", "refit", "pairs", "total", "rewrit", "new",
         ]
         .map(|c| format!("{c:>8}"))
         .join(" ")
     };
     println!(
-        "{:>5} | {} {:>6} | {} {:>6} | {:>6}",
+        "{:>5} | {} | {} | {} | {:>6} {:>6}",
         "frame",
         columns("A boxes"),
-        "new",
         columns("B update"),
-        "new",
-        "B/A"
+        columns("C update"),
+        "B/A",
+        "C/A"
     );
-    let (mut sum_a, mut sum_b) = (Frame::default(), Frame::default());
+    let mut sum = [Frame::default(); 3];
     // Over the checked frames: overlapping world boxes, and leaf pairs of one tree only.
     let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
+    let (mut missing, mut wrong) = (0, 0);
     for frame in 0..frames {
         scene.step();
-        let (fa, fb) = pipelines.frame(&scene);
+        let f = pipelines.frame(&scene);
+        if check {
+            let (m, w) = pipelines.check_c(n);
+            missing += m;
+            wrong += w;
+        }
         if verify {
             let mut tight = vec![Aabb3::EMPTY; n];
             batch
@@ -366,30 +465,30 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize, tuning: Tuning) 
             only_a += all_a.difference(&all_b).count();
             only_b += all_b.difference(&all_a).count();
         }
-        print_frame(&frame.to_string(), &fa, &fb);
-        for k in 0..5 {
-            sum_a.ms[k] += fa.ms[k];
-            sum_b.ms[k] += fb.ms[k];
+        print_frame(&frame.to_string(), &f);
+        for (total, f) in sum.iter_mut().zip(&f) {
+            for k in 0..5 {
+                total.ms[k] += f.ms[k];
+            }
+            total.rewritten += f.rewritten;
+            total.pairs += f.pairs;
         }
-        sum_a.rewritten += fa.rewritten;
-        sum_b.rewritten += fb.rewritten;
-        sum_a.pairs += fa.pairs;
-        sum_b.pairs += fb.pairs;
     }
-    let mean = |s: Frame| {
+    let mean = sum.map(|s| {
         let f = frames.max(1) as f64;
         Frame {
             ms: s.ms.map(|x| x / f),
             rewritten: (s.rewritten as f64 / f).round() as usize,
             pairs: (s.pairs as f64 / f).round() as usize,
         }
-    };
-    print_frame("mean", &mean(sum_a), &mean(sum_b));
+    });
+    print_frame("mean", &mean);
     // What the narrow phase inherits: every pair of overlapping leaves, new or not.
     println!(
-        "overlapping leaf pairs after the last frame: A {}, B {}",
+        "overlapping leaf pairs after the last frame: A {}, B {}, C {}",
         pipelines.a.all_pairs().len(),
-        pipelines.b.all_pairs().len()
+        pipelines.b.all_pairs().len(),
+        pipelines.c.tree.overlapping_pairs().len()
     );
     if verify {
         let f = frames.max(1) as f64;
@@ -402,27 +501,34 @@ pub fn run(n: usize, frames: usize, asleep: f64, island: usize, tuning: Tuning) 
             only_b as f64 / f
         );
     }
+    if check {
+        println!(
+            "C's begun pairs against a sweep over its fat boxes, every frame: {missing} \
+             missing, {wrong} wrong"
+        );
+    }
+    Summary {
+        frame: mean.map(|m| m.total()),
+        missing,
+        wrong,
+        checked: if check { frames } else { 0 },
+    }
 }
 
-fn print_frame(label: &str, a: &Frame, b: &Frame) {
+fn print_frame(label: &str, f: &[Frame; 3]) {
+    let cells = |x: &Frame| {
+        let mut c: Vec<String> = x.ms.iter().map(|v| format!("{v:>8.3}")).collect();
+        c.push(format!("{:>8.3}", x.total()));
+        c.push(format!("{:>8}", x.rewritten));
+        c.push(format!("{:>8}", x.pairs));
+        c.join(" ")
+    };
     println!(
-        "{label:>5} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8} {:>6} | {:>5.2}×",
-        a.ms[0],
-        a.ms[1],
-        a.ms[2],
-        a.ms[3],
-        a.ms[4],
-        a.total(),
-        a.rewritten,
-        a.pairs,
-        b.ms[0],
-        b.ms[1],
-        b.ms[2],
-        b.ms[3],
-        b.ms[4],
-        b.total(),
-        b.rewritten,
-        b.pairs,
-        b.total() / a.total()
+        "{label:>5} | {} | {} | {} | {:>5.2}× {:>5.2}×",
+        cells(&f[0]),
+        cells(&f[1]),
+        cells(&f[2]),
+        f[1].total() / f[0].total(),
+        f[2].total() / f[0].total()
     );
 }
