@@ -159,7 +159,11 @@ fn layouts3<T: Transform3, P: Exactly<3>>(
     let bits = |b: &Aabb3| [b.min.to_array(), b.max.to_array()].map(|v| v.map(f32::to_bits));
     for ((l, x), o) in local.iter().zip(&xfs).zip(&out) {
         let single = l.transformed(x, batch.method, batch.rounding);
-        assert_eq!(bits(o), bits(&single), "aos {what}: not the single-box bits of {l:?}");
+        assert_eq!(
+            bits(o),
+            bits(&single),
+            "aos {what}: not the single-box bits of {l:?}"
+        );
     }
     let (lb, xb) = (Block8::pack(&local), Block8::pack(&xfs));
     let mut ob = vec![Block8::<Aabb3>::default(); lb.len()];

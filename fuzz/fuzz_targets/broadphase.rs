@@ -11,12 +11,12 @@
 //! is refused with nothing written.
 #![no_main]
 
-use bvkit::{LargeWorld, Swept};
-use bvkit::{Transform2, Transform3};
 use bvkit::{
     Aabb2, Aabb3, Active, Backend, Batch, BatchError, Block8, LargeRigid3, Margin, Method, Moved,
     Rounding, Soa, Translation2, Translation3,
 };
+use bvkit::{LargeWorld, Swept};
+use bvkit::{Transform2, Transform3};
 use bvkit_fuzz::oracle::{Exact, Exactly, Expected, Problem, QuatProblem};
 use bvkit_fuzz::{Floats, affine2, affine3, rigid2};
 use glam::{DAffine3, DMat3, DVec3, Quat, Vec2, Vec3A};

@@ -2,7 +2,7 @@
 //! contract through the exact oracle: any quaternion, unit or not.
 #![no_main]
 
-use bvkit::{Method, Rounding, Rigid3, Transform3};
+use bvkit::{Method, Rigid3, Rounding, Transform3};
 use bvkit_fuzz::{Floats, assert_contract, bound_of};
 use libfuzzer_sys::fuzz_target;
 

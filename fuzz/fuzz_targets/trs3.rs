@@ -2,7 +2,7 @@
 //! contract through the exact oracle: any quaternion and per-axis scale.
 #![no_main]
 
-use bvkit::{Method, Rounding, Trs3, Transform3};
+use bvkit::{Method, Rounding, Transform3, Trs3};
 use bvkit_fuzz::{Floats, assert_contract, bound_of};
 use libfuzzer_sys::fuzz_target;
 

@@ -10,7 +10,7 @@
 use bvkit::{Aabb2, Aabb3, Active, Batch, Block8, Margin, Method, Moved, Rounding};
 use bvkit::{LargePose, LargeRigid3, LargeWorld, PoseSource, Rigid2, Swept};
 use bvkit_fuzz::Floats;
-use bvkit_fuzz::oracle::{Exact, Expected, Exactly, QuatProblem};
+use bvkit_fuzz::oracle::{Exact, Exactly, Expected, QuatProblem};
 use glam::{DAffine3, DVec3, Vec2, Vec3A};
 use libfuzzer_sys::fuzz_target;
 
@@ -59,10 +59,25 @@ fn repeat<P: PoseSource<3> + Copy>(
     let mut moved = Moved::new();
     let mut fat = [*fat0];
     for _ in 0..2 {
-        batch.update(margin, Active::All, &[*local][..], poses, &mut fat[..], &mut moved).unwrap();
+        batch
+            .update(
+                margin,
+                Active::All,
+                &[*local][..],
+                poses,
+                &mut fat[..],
+                &mut moved,
+            )
+            .unwrap();
     }
-    assert!(moved.is_empty() || invalid, "{what}: moved again with unchanged poses");
-    assert!(moved.contains(0) || !invalid, "{what}: an invalid box not reported");
+    assert!(
+        moved.is_empty() || invalid,
+        "{what}: moved again with unchanged poses"
+    );
+    assert!(
+        moved.contains(0) || !invalid,
+        "{what}: an invalid box not reported"
+    );
 }
 
 fuzz_target!(|data: &[u8]| {
@@ -91,7 +106,14 @@ fuzz_target!(|data: &[u8]| {
             let what = format!("{method:?} deterministic {deterministic}");
             let mut moved = Moved::new();
             let mut fat = [fat0];
-            let result = batch.update(margin, Active::All, &local[..], &now[..], &mut fat[..], &mut moved);
+            let result = batch.update(
+                margin,
+                Active::All,
+                &local[..],
+                &now[..],
+                &mut fat[..],
+                &mut moved,
+            );
             if !valid_margin {
                 assert!(result.is_err() && bits(&fat[0]) == bits(&fat0), "{what}");
                 continue;
@@ -100,17 +122,36 @@ fuzz_target!(|data: &[u8]| {
             holds(&p, &fat[0], &what);
             // A changed fat box is reported, and a NaN pose always is.
             let changed = bits(&fat[0]) != bits(&fat0);
-            assert!(moved.contains(0) || !changed, "{what}: rewritten but not reported");
+            assert!(
+                moved.contains(0) || !changed,
+                "{what}: rewritten but not reported"
+            );
             if let Expected::Invalid = p.expected() {
                 assert!(moved.contains(0), "{what}: NaN input not reported");
             }
             let mut fat = [fat0];
-            let swept = Swept { current: &now[..], predicted: &next[..] };
-            batch.update(margin, Active::All, &local[..], swept, &mut fat[..], &mut moved).unwrap();
+            let swept = Swept {
+                current: &now[..],
+                predicted: &next[..],
+            };
+            batch
+                .update(
+                    margin,
+                    Active::All,
+                    &local[..],
+                    swept,
+                    &mut fat[..],
+                    &mut moved,
+                )
+                .unwrap();
             // NaN at either pose makes the swept box invalid; otherwise it holds both images.
             let nan = |x: &QuatProblem| matches!(x.expected(), Expected::Invalid);
             if nan(&p) || nan(&q) {
-                assert!(!fat[0].is_valid(), "{what} swept: NaN input hidden in {:?}", fat[0]);
+                assert!(
+                    !fat[0].is_valid(),
+                    "{what} swept: NaN input hidden in {:?}",
+                    fat[0]
+                );
             } else {
                 holds(&p, &fat[0], &format!("{what} swept, current"));
                 holds(&q, &fat[0], &format!("{what} swept, predicted"));
@@ -122,38 +163,117 @@ fuzz_target!(|data: &[u8]| {
             let r = now[0];
             let large = [LargeRigid3::new(r.rotation, r.translation.as_dvec3())];
             let m = glam::Mat3A::from_quat(r.rotation);
-            let daffine = [DAffine3 { matrix3: m.as_dmat3(), translation: r.translation.as_dvec3() }];
-            let world = LargeWorld { poses: &large[..], origin };
-            let dworld = LargeWorld { poses: &daffine[..], origin };
+            let daffine = [DAffine3 {
+                matrix3: m.as_dmat3(),
+                translation: r.translation.as_dvec3(),
+            }];
+            let world = LargeWorld {
+                poses: &large[..],
+                origin,
+            };
+            let dworld = LargeWorld {
+                poses: &daffine[..],
+                origin,
+            };
             let rigid = bad(b.transformed(&r, method, Rounding::Outward));
             let next_bad = bad(b.transformed(&next[0], method, Rounding::Outward));
             let large_bad = bad(large[0].relative_aabb(&b, origin, method));
             let dlarge_bad = bad(daffine[0].relative_aabb(&b, origin, method));
-            let swept = Swept { current: &now[..], predicted: &next[..] };
-            let large_swept = Swept { current: world, predicted: dworld };
+            let swept = Swept {
+                current: &now[..],
+                predicted: &next[..],
+            };
+            let large_swept = Swept {
+                current: world,
+                predicted: dworld,
+            };
             let (b0, f0) = (&b, &fat0);
-            repeat(&batch, margin, b0, f0, &now[..], rigid, &format!("{what} rigid3"));
-            repeat(&batch, margin, b0, f0, swept, rigid || next_bad, &format!("{what} swept"));
-            repeat(&batch, margin, b0, f0, world, large_bad, &format!("{what} large rigid3"));
-            repeat(&batch, margin, b0, f0, dworld, dlarge_bad, &format!("{what} large daffine3"));
+            repeat(
+                &batch,
+                margin,
+                b0,
+                f0,
+                &now[..],
+                rigid,
+                &format!("{what} rigid3"),
+            );
+            repeat(
+                &batch,
+                margin,
+                b0,
+                f0,
+                swept,
+                rigid || next_bad,
+                &format!("{what} swept"),
+            );
+            repeat(
+                &batch,
+                margin,
+                b0,
+                f0,
+                world,
+                large_bad,
+                &format!("{what} large rigid3"),
+            );
+            repeat(
+                &batch,
+                margin,
+                b0,
+                f0,
+                dworld,
+                dlarge_bad,
+                &format!("{what} large daffine3"),
+            );
             let both = large_bad || dlarge_bad;
-            repeat(&batch, margin, b0, f0, large_swept, both, &format!("{what} swept large"));
+            repeat(
+                &batch,
+                margin,
+                b0,
+                f0,
+                large_swept,
+                both,
+                &format!("{what} swept large"),
+            );
             // AoSoA blocks, which run the lane loop on every backend.
             let (l8, p8) = (Block8::pack(&[b]), Block8::pack(&now[..]));
             let mut f8 = Block8::pack(&[fat0]);
             let mut moved = Moved::new();
             for _ in 0..2 {
-                batch.update(margin, Active::All, &l8[..], &p8[..], &mut f8[..], &mut moved).unwrap();
+                batch
+                    .update(
+                        margin,
+                        Active::All,
+                        &l8[..],
+                        &p8[..],
+                        &mut f8[..],
+                        &mut moved,
+                    )
+                    .unwrap();
             }
-            assert!(moved.is_empty() || rigid, "{what} rigid3x8: moved again with unchanged poses");
+            assert!(
+                moved.is_empty() || rigid,
+                "{what} rigid3x8: moved again with unchanged poses"
+            );
             // 2D: the box's x and y, at a rotation about z.
             let b2 = Aabb2::new(Vec2::new(p.lo[0], p.lo[1]), Vec2::new(p.hi[0], p.hi[1]));
             let mut fat2 = [Aabb2::new(fat0.min.truncate(), fat0.max.truncate())];
             for _ in 0..2 {
-                batch.update(margin, Active::All, &[b2][..], &[r2][..], &mut fat2[..], &mut moved).unwrap();
+                batch
+                    .update(
+                        margin,
+                        Active::All,
+                        &[b2][..],
+                        &[r2][..],
+                        &mut fat2[..],
+                        &mut moved,
+                    )
+                    .unwrap();
             }
             let invalid2 = !b2.transformed(&r2, method, Rounding::Outward).is_valid();
-            assert!(moved.is_empty() || invalid2, "{what} rigid2: moved again with unchanged poses");
+            assert!(
+                moved.is_empty() || invalid2,
+                "{what} rigid2: moved again with unchanged poses"
+            );
         }
     }
 });

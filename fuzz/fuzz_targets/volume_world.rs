@@ -7,10 +7,8 @@
 //! `transformed` holds the exact images of the volume's extreme points.
 #![no_main]
 
-use bvkit::{
-    Aabb3, BatchError, Capsule, Obb3, Rounding, Similarity3, Sphere, Translation3,
-};
 use bvkit::Transform3;
+use bvkit::{Aabb3, BatchError, Capsule, Obb3, Rounding, Similarity3, Sphere, Translation3};
 use bvkit_fuzz::Floats;
 use bvkit_fuzz::affine3;
 use bvkit_fuzz::volumes::world::{
@@ -25,11 +23,7 @@ fn bits(b: &Aabb3) -> [u32; 6] {
 }
 
 /// The world boxes of `v` under `xf`, single and batched, against the contract.
-fn world<V: Volume, T: Transform3 + Copy + core::fmt::Debug>(
-    v: V,
-    xf: T,
-    map: Option<&XMap>,
-) {
+fn world<V: Volume, T: Transform3 + Copy + core::fmt::Debug>(v: V, xf: T, map: Option<&XMap>) {
     let sentinel = Aabb3::new(Vec3A::splat(7.0), Vec3A::splat(-7.0));
     let expected = v.expected(map);
     for rounding in Rounding::ALL {

@@ -54,14 +54,15 @@
 //! proxy rewrites, stays the size of the awake set. Pairs between the two are found as any
 //! other (a moved proxy queries both).
 
-mod wide;
+mod hierarchy;
 
 use crate::aabb::Aabb3;
 use crate::layout::BoxSource;
 use alloc::vec::Vec;
 use core::fmt;
 use core::mem::take;
-use wide::{Hierarchy, Places, Slot, overlap};
+use glam::Vec3A;
+use hierarchy::{Hierarchy, Places, Slot, overlap};
 
 /// Why the tree refused an input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,13 +162,29 @@ const ASLEEP: u32 = 1 << 31;
 /// Ids are packed in 31 bits, with the two codes above kept out of range.
 const MAX_ID: u32 = (1 << 31) - 2;
 
-/// A proxy whose box changed since the last report: its box then and now (the empty box
-/// when it had, or has, none).
+/// A proxy whose box changed since the last report, and its box then (the empty box when
+/// it had none).
 #[derive(Clone, Copy, Debug)]
 struct Change {
     id: u32,
-    old: Aabb3,
-    new: Aabb3,
+    /// The old box's `min` then `max` (28 bytes a change, not 48).
+    old: [f32; 6],
+}
+
+impl Change {
+    fn new(id: u32, old: &Aabb3) -> Self {
+        let (min, max) = (old.min, old.max);
+        Self {
+            id,
+            old: [min.x, min.y, min.z, max.x, max.y, max.z],
+        }
+    }
+
+    #[inline(always)]
+    fn old(&self) -> Aabb3 {
+        let o = &self.old;
+        Aabb3::new(Vec3A::new(o[0], o[1], o[2]), Vec3A::new(o[3], o[4], o[5]))
+    }
 }
 
 /// Sends a hierarchy's proxy moves to the per-proxy places.
@@ -241,11 +258,7 @@ impl DynamicTree {
             at: alloc::vec![ABSENT; len],
             mark: (1..=len as u32).collect(),
             pending: (0..len as u32)
-                .map(|id| Change {
-                    id,
-                    old: Aabb3::EMPTY,
-                    new: Aabb3::EMPTY,
-                })
+                .map(|id| Change::new(id, &Aabb3::EMPTY))
                 .collect(),
             len,
             ..Self::default()
@@ -325,11 +338,7 @@ impl DynamicTree {
     fn note(&mut self, id: u32) {
         if self.mark[id as usize] == 0 {
             let old = self.current(id);
-            self.pending.push(Change {
-                id,
-                old,
-                new: Aabb3::EMPTY,
-            });
+            self.pending.push(Change::new(id, &old));
             self.mark[id as usize] = self.pending.len() as u32;
         }
     }
@@ -496,7 +505,8 @@ impl DynamicTree {
         // The boxes read in id order, then written in slot order: the build lays nodes out
         // depth first, so the writes sweep the nodes instead of jumping between them.
         let (mut fresh, mut order) = (take(&mut self.fresh), take(&mut self.order));
-        (fresh.clear(), order.clear());
+        fresh.clear();
+        order.clear();
         for &id in moved {
             if let Some(&at) = self.at.get(id as usize)
                 && at != ABSENT
@@ -544,22 +554,25 @@ impl DynamicTree {
         let mut changes = take(&mut self.pending);
         let mut order = take(&mut self.order);
         order.clear();
-        for (i, c) in changes.iter_mut().enumerate() {
-            c.new = self.current(c.id);
+        for (i, c) in changes.iter().enumerate() {
             order.push(u64::from(self.at[c.id as usize]) << 32 | i as u64);
         }
         // Queries in slot order: neighbours in the tree share their paths in the caches.
         order.sort_unstable();
         let ended = pairs.ended_wanted;
         let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
-        let (awake, asleep, mark) = (&self.awake, &self.asleep, &self.mark[..]);
+        let view = View {
+            hierarchies: [&self.awake, &self.asleep],
+            at: &self.at,
+            mark: &self.mark,
+        };
         let stack = &mut self.stack;
         crate::simd::plain(
             #[inline(always)]
             || {
-                search(&changes, &order, [awake, asleep], mark, stack, begun);
+                search(&changes, &order, &view, stack, begun);
                 if ended {
-                    search_ended(&changes, &order, [awake, asleep], mark, stack, ended_pairs);
+                    search_ended(&changes, &order, &view, stack, ended_pairs);
                 }
             },
         );
@@ -571,6 +584,32 @@ impl DynamicTree {
     }
 }
 
+/// What a report reads: the two hierarchies, where each proxy is, and the change marks.
+struct View<'a> {
+    hierarchies: [&'a Hierarchy; 2],
+    at: &'a [u32],
+    mark: &'a [u32],
+}
+
+impl View<'_> {
+    /// The box proxy `id` has now, or the empty box.
+    #[inline(always)]
+    fn current(&self, id: u32) -> Aabb3 {
+        match self.at[id as usize] {
+            ABSENT | PARKED => Aabb3::EMPTY,
+            at => self.hierarchies[usize::from(at & ASLEEP != 0)].get(Slot(at & !ASLEEP)),
+        }
+    }
+
+    /// Calls `hit(id, box)` for every placed proxy whose box overlaps `q`.
+    #[inline(always)]
+    fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
+        for h in self.hierarchies {
+            h.query(q, stack, &mut hit);
+        }
+    }
+}
+
 /// The begun pairs: each changed proxy's new box against both hierarchies. A pair of two
 /// changed proxies is taken from the larger id's query, and began when their old boxes did
 /// not overlap; a pair with an unchanged proxy began when the changed one's old box did not
@@ -579,31 +618,30 @@ impl DynamicTree {
 fn search(
     changes: &[Change],
     order: &[u64],
-    hierarchies: [&Hierarchy; 2],
-    mark: &[u32],
+    view: &View<'_>,
     stack: &mut Vec<u32>,
     begun: &mut Vec<(u32, u32)>,
 ) {
     for &key in order {
         let c = &changes[key as u32 as usize];
-        if c.new.min.x > c.new.max.x {
+        let new = view.current(c.id);
+        if new.min.x > new.max.x {
             continue;
         }
-        for h in hierarchies {
-            h.query(&c.new, stack, |other, b| {
-                if other == c.id {
-                    return;
-                }
-                let was = match mark[other as usize] {
-                    0 => overlap(&c.old, b),
-                    m if other < c.id => overlap(&c.old, &changes[m as usize - 1].old),
-                    _ => return,
-                };
-                if !was {
-                    begun.push((c.id.min(other), c.id.max(other)));
-                }
-            });
-        }
+        let old = c.old();
+        view.query(&new, stack, |other, b| {
+            if other == c.id {
+                return;
+            }
+            let was = match view.mark[other as usize] {
+                0 => overlap(&old, b),
+                m if other < c.id => overlap(&old, &changes[m as usize - 1].old()),
+                _ => return,
+            };
+            if !was {
+                begun.push((c.id.min(other), c.id.max(other)));
+            }
+        });
     }
 }
 
@@ -614,40 +652,34 @@ fn search(
 fn search_ended(
     changes: &[Change],
     order: &[u64],
-    hierarchies: [&Hierarchy; 2],
-    mark: &[u32],
+    view: &View<'_>,
     stack: &mut Vec<u32>,
     ended: &mut Vec<(u32, u32)>,
 ) {
-    let mut olds: Vec<u32> = Vec::new();
+    // The changed proxies that had a box: id, old box, new box.
+    let mut olds: Vec<(u32, Aabb3, Aabb3)> = Vec::new();
     for &key in order {
-        let i = key as u32 as usize;
-        let c = &changes[i];
-        if c.old.min.x > c.old.max.x {
+        let c = &changes[key as u32 as usize];
+        let old = c.old();
+        if old.min.x > old.max.x {
             continue;
         }
-        olds.push(i as u32);
-        for h in hierarchies {
-            h.query(&c.old, stack, |other, b| {
-                if mark[other as usize] == 0 && !overlap(&c.new, b) {
-                    ended.push((c.id.min(other), c.id.max(other)));
-                }
-            });
-        }
+        let new = view.current(c.id);
+        olds.push((c.id, old, new));
+        view.query(&old, stack, |other, b| {
+            if view.mark[other as usize] == 0 && !overlap(&new, b) {
+                ended.push((c.id.min(other), c.id.max(other)));
+            }
+        });
     }
-    olds.sort_unstable_by(|&a, &b| {
-        let (a, b) = (&changes[a as usize].old, &changes[b as usize].old);
-        a.min.x.total_cmp(&b.min.x)
-    });
-    for (k, &i) in olds.iter().enumerate() {
-        let a = &changes[i as usize];
-        for &j in &olds[k + 1..] {
-            let b = &changes[j as usize];
-            if b.old.min.x > a.old.max.x {
+    olds.sort_unstable_by(|a, b| a.1.min.x.total_cmp(&b.1.min.x));
+    for (k, a) in olds.iter().enumerate() {
+        for b in &olds[k + 1..] {
+            if b.1.min.x > a.1.max.x {
                 break;
             }
-            if overlap(&a.old, &b.old) && !overlap(&a.new, &b.new) {
-                ended.push((a.id.min(b.id), a.id.max(b.id)));
+            if overlap(&a.1, &b.1) && !overlap(&a.2, &b.2) {
+                ended.push((a.0.min(b.0), a.0.max(b.0)));
             }
         }
     }

@@ -11,6 +11,7 @@
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
 use glam::Vec3A;
+use wide::f32x8;
 
 /// Children per node.
 pub(crate) const WIDTH: usize = 8;
@@ -86,23 +87,36 @@ impl Node {
         Aabb3::new(Vec3A::from_array(lo), Vec3A::from_array(hi))
     }
 
-    /// Bit `k` set when child `k`'s box overlaps `[lo, hi]` (closed boxes); a branch-free
-    /// loop over the columns, which compiles to a few vector compares.
+    /// Bit `k` set when child `k`'s box overlaps the query's (closed boxes): twelve lane
+    /// compares.
     #[inline(always)]
-    fn overlaps(&self, lo: &[f32; 3], hi: &[f32; 3]) -> u32 {
-        let mut bits = 0;
-        for k in 0..WIDTH {
-            let mut hit = true;
-            for a in 0..3 {
-                hit &= (lo[a] <= self.max[a][k]) & (self.min[a][k] <= hi[a]);
-            }
-            bits |= u32::from(hit) << k;
+    fn overlaps(&self, q: &Query) -> u32 {
+        let mut hit = f32x8::splat(0.0).simd_le(f32x8::splat(0.0));
+        for a in 0..3 {
+            hit &= q.min[a].simd_le(f32x8::new(self.max[a]));
+            hit &= f32x8::new(self.min[a]).simd_le(q.max[a]);
         }
-        bits
+        hit.to_bitmask()
     }
 
     fn free_child(&self) -> Option<usize> {
         self.child.iter().position(|&c| c == NONE)
+    }
+}
+
+/// A query box, each face splat across the lanes.
+pub(crate) struct Query {
+    min: [f32x8; 3],
+    max: [f32x8; 3],
+}
+
+impl Query {
+    #[inline(always)]
+    fn new(b: &Aabb3) -> Self {
+        Self {
+            min: [0, 1, 2].map(|a| f32x8::splat(b.min[a])),
+            max: [0, 1, 2].map(|a| f32x8::splat(b.max[a])),
+        }
     }
 }
 
@@ -276,12 +290,12 @@ impl Hierarchy {
     /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with `stack` as scratch.
     #[inline(always)]
     pub(crate) fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
-        let (lo, hi) = (q.min.to_array(), q.max.to_array());
+        let q = Query::new(q);
         stack.clear();
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            let mut bits = node.overlaps(&lo, &hi);
+            let mut bits = node.overlaps(&q);
             while bits != 0 {
                 let k = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
