@@ -183,6 +183,18 @@ impl Hierarchy {
         self.nodes[slot.node() as usize].get(slot.child())
     }
 
+    /// Asks for the cache lines of `slot`'s node (all four: the box columns, the children
+    /// and the parent).
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, slot: Slot) {
+        if let Some(node) = self.nodes.get(slot.node() as usize) {
+            crate::simd::prefetch(&node.min[0]);
+            crate::simd::prefetch(&node.min[2]);
+            crate::simd::prefetch(&node.max[1]);
+            crate::simd::prefetch(&node.child);
+        }
+    }
+
     /// The number of nodes in use.
     pub(crate) fn nodes(&self) -> usize {
         self.nodes.len() - self.free.len()

@@ -502,27 +502,37 @@ impl DynamicTree {
         {
             return Err(BroadphaseError::MissingBox { id, len });
         }
-        // The boxes read in id order, then written in slot order: the build lays nodes out
-        // depth first, so the writes sweep the nodes instead of jumping between them.
-        let (mut fresh, mut order) = (take(&mut self.fresh), take(&mut self.order));
-        fresh.clear();
-        order.clear();
-        for &id in moved {
-            if let Some(&at) = self.at.get(id as usize)
-                && at != ABSENT
-            {
-                let (min, max) = fat.get(id as usize);
-                order.push(u64::from(at) << 32 | fresh.len() as u64);
-                fresh.push((id, Aabb3::new(min.into(), max.into())));
+        // In id order, which reads `fat`, `at` and `mark` as streams; the nodes, scattered,
+        // are asked for a few proxies ahead so that their cache misses overlap.
+        const AHEAD: usize = 8;
+        let (fresh, order) = (take(&mut self.fresh), take(&mut self.order));
+        for (k, &id) in moved.iter().enumerate() {
+            if let Some(&next) = moved.get(k + AHEAD) {
+                self.prefetch(next);
             }
-        }
-        order.sort_unstable();
-        for &key in &order {
-            let (id, b) = fresh[key as u32 as usize];
-            self.set(id, &b);
+            if self.contains(id) {
+                let (min, max) = fat.get(id as usize);
+                self.set(id, &Aabb3::new(min.into(), max.into()));
+            }
         }
         (self.fresh, self.order) = (fresh, order);
         Ok(())
+    }
+
+    /// Asks for the cache lines of proxy `id`'s node.
+    #[inline(always)]
+    fn prefetch(&self, id: u32) {
+        if let Some(&at) = self.at.get(id as usize)
+            && at != ABSENT
+            && at != PARKED
+        {
+            let h = if at & ASLEEP != 0 {
+                &self.asleep
+            } else {
+                &self.awake
+            };
+            h.prefetch(Slot(at & !ASLEEP));
+        }
     }
 
     /// Gives proxy `id` (in the tree) box `b`, or parks it when `b` is refused.
@@ -563,7 +573,6 @@ impl DynamicTree {
         let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
             hierarchies: [&self.awake, &self.asleep],
-            at: &self.at,
             mark: &self.mark,
         };
         let stack = &mut self.stack;
@@ -584,18 +593,35 @@ impl DynamicTree {
     }
 }
 
-/// What a report reads: the two hierarchies, where each proxy is, and the change marks.
+/// What a report reads: the two hierarchies and the change marks.
 struct View<'a> {
     hierarchies: [&'a Hierarchy; 2],
-    at: &'a [u32],
     mark: &'a [u32],
 }
 
+/// The changes in `order` (each key a change's place, then its index), with each change's
+/// new box read from its place; the changes themselves, scattered in this order, are asked
+/// for a few keys ahead.
+#[inline(always)]
+fn in_order<'c>(
+    changes: &'c [Change],
+    order: &'c [u64],
+    view: &'c View<'_>,
+) -> impl Iterator<Item = (&'c Change, Aabb3)> + 'c {
+    const AHEAD: usize = 8;
+    order.iter().enumerate().map(move |(k, &key)| {
+        if let Some(&next) = order.get(k + AHEAD) {
+            crate::simd::prefetch(&changes[next as u32 as usize]);
+        }
+        (&changes[key as u32 as usize], view.at((key >> 32) as u32))
+    })
+}
+
 impl View<'_> {
-    /// The box proxy `id` has now, or the empty box.
+    /// The box at place `at` (a slot, or the empty box for an absent or parked proxy).
     #[inline(always)]
-    fn current(&self, id: u32) -> Aabb3 {
-        match self.at[id as usize] {
+    fn at(&self, at: u32) -> Aabb3 {
+        match at {
             ABSENT | PARKED => Aabb3::EMPTY,
             at => self.hierarchies[usize::from(at & ASLEEP != 0)].get(Slot(at & !ASLEEP)),
         }
@@ -622,9 +648,7 @@ fn search(
     stack: &mut Vec<u32>,
     begun: &mut Vec<(u32, u32)>,
 ) {
-    for &key in order {
-        let c = &changes[key as u32 as usize];
-        let new = view.current(c.id);
+    for (c, new) in in_order(changes, order, view) {
         if new.min.x > new.max.x {
             continue;
         }
@@ -658,13 +682,11 @@ fn search_ended(
 ) {
     // The changed proxies that had a box: id, old box, new box.
     let mut olds: Vec<(u32, Aabb3, Aabb3)> = Vec::new();
-    for &key in order {
-        let c = &changes[key as u32 as usize];
+    for (c, new) in in_order(changes, order, view) {
         let old = c.old();
         if old.min.x > old.max.x {
             continue;
         }
-        let new = view.current(c.id);
         olds.push((c.id, old, new));
         view.query(&old, stack, |other, b| {
             if view.mark[other as usize] == 0 && !overlap(&new, b) {
