@@ -84,6 +84,10 @@ fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
         .update(margin, Active::All, &local, &poses, &mut fat, &mut moved)
         .unwrap();
     let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    // Rebuilt by its upkeep every few frames (two moves per proxy), besides the explicit
+    // rebuilds below.
+    tree.set_rebuild_after(2.0);
+    let mut maintained = 0;
     let mut member = vec![true; N];
     let mut awake = vec![true; N];
     let mut before = Set::new();
@@ -148,7 +152,9 @@ fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
         if frame % 25 == 24 {
             tree.rebuild();
         }
-        tree.update(moved.indices(), &fat, &mut pairs).unwrap();
+        tree.write(moved.indices(), &fat).unwrap();
+        maintained += usize::from(tree.maintain());
+        tree.report(&mut pairs);
         let now = brute_force(&fat, &member);
         check(frame, &pairs, &before, &now, &tree);
         assert!(pairs.refused.is_empty());
@@ -170,6 +176,7 @@ fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
         "slept {slept}, removed {removed}"
     );
     assert!(before.len() > 300, "{} pairs at the end", before.len());
+    assert!(maintained > 10, "{maintained} rebuilds by the upkeep");
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! The broadphase's dynamic tree against a brute-force reference, over any sequence of
-//! inserts, removes, moves (`write`), reports, sleeps, wakes and rebuilds, with any boxes:
-//! small integer boxes that overlap often, and faces of any bits (NaN, ±∞, ±MAX,
+//! inserts, removes, moves (`write`), reports, sleeps, wakes, rebuilds and upkeep (`maintain`),
+//! with any boxes: small integer boxes that overlap often, and faces of any bits (NaN, ±∞, ±MAX,
 //! subnormals). After every operation the tree holds what the reference holds (placed,
 //! parked or absent, asleep or awake, and each box bit for bit); every report's begun and
 //! ended pairs are exactly the differences of the brute-force pair sets since the last
@@ -146,7 +146,15 @@ fuzz_target!(|data: &[u8]| {
                     }
                 }
             }
-            5 => tree.rebuild(),
+            5 => {
+                if f.byte() % 2 == 0 {
+                    tree.rebuild();
+                } else {
+                    // The upkeep, rebuilding any hierarchy that took a move since its build.
+                    tree.set_rebuild_after(0.0);
+                    tree.maintain();
+                }
+            }
             _ => {}
         }
         if op == 6 || op == 7 {

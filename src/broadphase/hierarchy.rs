@@ -2,14 +2,16 @@
 //! columns (eight `min.x`, then eight `min.y`, …), so that one query tests all eight
 //! children at once; a child is another node or a proxy (a leaf).
 //!
-//! **Containment.** A proxy's slot holds its box, and a node's slot in its parent contains
-//! the union of the node's slots: boxes are combined with `min` and `max` only, which round
-//! nothing, and a new box enlarges the slots above it until one already contains it
-//! ([`Hierarchy::set`]). So a query visits every proxy whose box it overlaps. Slots are
-//! exact unions after a build; moves leave them loose, never short.
+//! **Containment.** A proxy's slot holds its box, and a node's slot in its parent holds the
+//! exact union of the node's slots: boxes are combined with `min` and `max` only, which
+//! round nothing. A new box enlarges the slots above it up to the first that already
+//! contains it ([`Hierarchy::set`], Box2D's early exit), and a remove recomputes the unions
+//! above it while they change. So a query visits every proxy whose box it overlaps. A build
+//! makes every slot exact; moves leave slots loose, never short, until the next one.
 
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
+use core::mem::take;
 use glam::Vec3A;
 use wide::f32x8;
 
@@ -161,6 +163,9 @@ pub(crate) fn overlap(a: &Aabb3, b: &Aabb3) -> bool {
 pub(crate) struct Hierarchy {
     nodes: Vec<Node>,
     free: Vec<u32>,
+    /// A build's scratch, kept so that a rebuild does not fault its pages in again.
+    items: Vec<(u32, Aabb3)>,
+    centres: Vec<Centre>,
 }
 
 impl Default for Hierarchy {
@@ -168,6 +173,8 @@ impl Default for Hierarchy {
         Self {
             nodes: alloc::vec![Node::new(Slot(NONE))],
             free: Vec::new(),
+            items: Vec::new(),
+            centres: Vec::new(),
         }
     }
 }
@@ -201,21 +208,41 @@ impl Hierarchy {
     }
 
     fn alloc(&mut self, parent: Slot) -> u32 {
+        let node = Node::new(parent);
         match self.free.pop() {
             Some(n) => {
-                self.nodes[n as usize] = Node::new(parent);
+                self.nodes[n as usize] = node;
                 n
             }
             None => {
-                self.nodes.push(Node::new(parent));
+                self.nodes.push(node);
                 (self.nodes.len() - 1) as u32
             }
         }
     }
 
+    /// Recomputes the unions above node `n` while a parent's slot changes.
+    fn refit_up(&mut self, mut n: u32) {
+        loop {
+            let node = &self.nodes[n as usize];
+            let parent = node.parent;
+            if parent.0 == NONE {
+                return;
+            }
+            let b = node.union();
+            let p = &mut self.nodes[parent.node() as usize];
+            if p.get(parent.child()) == b {
+                return;
+            }
+            p.set(parent.child(), &b);
+            n = parent.node();
+        }
+    }
+
     /// Writes the box of the proxy in `slot`, and enlarges the slots above it until one
-    /// already contains the box (Box2D's early exit): a slot's box then still contains its
-    /// node's union, with room left where a child shrank or left.
+    /// already contains the box (Box2D's early exit): a slot then still contains its node's
+    /// union, with room left where a child shrank or left, until the next build.
+    #[inline(always)]
     pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
         self.nodes[slot.node() as usize].set(slot.child(), b);
         self.enlarge_above(slot.node(), b);
@@ -282,8 +309,8 @@ impl Hierarchy {
         }
     }
 
-    /// Takes the proxy in `slot` out; a node left empty leaves its parent (the boxes above
-    /// keep their room until a rebuild).
+    /// Takes the proxy in `slot` out; a node left empty leaves its parent, and the unions
+    /// above are recomputed.
     pub(crate) fn remove(&mut self, slot: Slot) {
         let (mut n, mut k) = (slot.node(), slot.child());
         loop {
@@ -291,6 +318,7 @@ impl Hierarchy {
             node.child[k] = NONE;
             node.set(k, &Aabb3::EMPTY);
             if n == 0 || node.child.iter().any(|&c| c != NONE) {
+                self.refit_up(n);
                 return;
             }
             let parent = node.parent;
@@ -321,13 +349,12 @@ impl Hierarchy {
         }
     }
 
-    /// Every proxy and its box, in no particular order.
-    pub(crate) fn proxies(&self) -> Vec<(u32, Aabb3)> {
-        let mut out = Vec::new();
+    /// Every proxy and its box, depth first, into `out`.
+    fn collect(&self, out: &mut Vec<(u32, Aabb3)>) {
         let mut stack = alloc::vec![0u32];
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            for k in 0..WIDTH {
+            for k in (0..WIDTH).rev() {
                 match Child::decode(node.child[k]) {
                     Some(Child::Proxy(id)) => out.push((id, node.get(k))),
                     Some(Child::Node(c)) => stack.push(c),
@@ -335,29 +362,64 @@ impl Hierarchy {
                 }
             }
         }
+    }
+
+    /// Every proxy and its box, depth first.
+    pub(crate) fn proxies(&self) -> Vec<(u32, Aabb3)> {
+        let mut out = Vec::new();
+        self.collect(&mut out);
         out
     }
 
-    /// A new hierarchy over `items` (ids and boxes), split top-down at the median of the
-    /// widest spread of centres until every node has eight children: balanced, so its
-    /// depth is about `log8(n)` whatever the distribution. Every proxy's slot goes to
-    /// `places`.
-    pub(crate) fn build(items: &mut [(u32, Aabb3)], places: &mut impl Places) -> Self {
-        let mut h = Self {
-            nodes: Vec::with_capacity(items.len() / 6 + 1),
-            free: Vec::new(),
-        };
-        h.nodes.push(Node::new(Slot(NONE)));
-        h.fill(0, items, places);
-        h
+    /// Rebuilds the hierarchy over its own proxies ([`Hierarchy::build`]).
+    pub(crate) fn rebuild(&mut self, places: &mut impl Places) {
+        let mut items = take(&mut self.items);
+        items.clear();
+        self.collect(&mut items);
+        self.build_from(items, places);
     }
 
-    /// Fills node `n` with `items`; returns its union.
-    fn fill(&mut self, n: u32, items: &mut [(u32, Aabb3)], places: &mut impl Places) -> Aabb3 {
+    /// Rebuilds the hierarchy over `boxes` (ids and boxes), reusing its memory: split
+    /// top-down at the median of the widest spread of centres until every node has eight
+    /// children. Balanced, so its depth is about `log8(n)` whatever the distribution. Every
+    /// proxy's slot goes to `places`.
+    pub(crate) fn build(
+        &mut self,
+        boxes: impl IntoIterator<Item = (u32, Aabb3)>,
+        places: &mut impl Places,
+    ) {
+        let mut items = take(&mut self.items);
+        items.clear();
+        items.extend(boxes);
+        self.build_from(items, places);
+    }
+
+    fn build_from(&mut self, items: Vec<(u32, Aabb3)>, places: &mut impl Places) {
+        let mut centres = take(&mut self.centres);
+        centres.clear();
+        centres.extend(items.iter().enumerate().map(|(i, (_, b))| {
+            let c = b.min * 0.5 + b.max * 0.5;
+            Centre([c.x, c.y, c.z], i as u32)
+        }));
+        self.nodes.clear();
+        self.free.clear();
+        self.nodes.push(Node::new(Slot(NONE)));
+        self.fill(0, &mut centres, &items, places);
+        (self.items, self.centres) = (items, centres);
+    }
+
+    /// Fills node `n` with the items of `centres`; returns its union.
+    fn fill(
+        &mut self,
+        n: u32,
+        centres: &mut [Centre],
+        items: &[(u32, Aabb3)],
+        places: &mut impl Places,
+    ) -> Aabb3 {
         // Up to eight groups, each the split of the largest one at its median.
         let mut groups = [(0usize, 0usize); WIDTH];
-        groups[0] = (0, items.len());
-        let mut count = usize::from(!items.is_empty());
+        groups[0] = (0, centres.len());
+        let mut count = usize::from(!centres.is_empty());
         while count < WIDTH {
             let Some((g, &(start, end))) = groups[..count]
                 .iter()
@@ -370,19 +432,20 @@ impl Hierarchy {
                 break;
             }
             let mid = start + (end - start) / 2;
-            split_at_median(&mut items[start..end], mid - start);
+            split_at_median(&mut centres[start..end], mid - start);
             groups[g] = (start, mid);
             groups[count] = (mid, end);
             count += 1;
         }
         for (k, &(start, end)) in groups[..count].iter().enumerate() {
             let (b, c) = if end - start == 1 {
-                let (id, b) = items[start];
+                let (id, b) = items[centres[start].1 as usize];
                 places.place(id, Slot::new(n, k));
                 (b, Child::Proxy(id))
             } else {
                 let m = self.alloc(Slot::new(n, k));
-                (self.fill(m, &mut items[start..end], places), Child::Node(m))
+                let b = self.fill(m, &mut centres[start..end], items, places);
+                (b, Child::Node(m))
             };
             let node = &mut self.nodes[n as usize];
             node.set(k, &b);
@@ -392,24 +455,29 @@ impl Hierarchy {
     }
 }
 
-/// Reorders `items` so that the first `mid` have the smallest centres along the axis where
-/// the centres spread widest.
-fn split_at_median(items: &mut [(u32, Aabb3)], mid: usize) {
-    let centre = |b: &Aabb3| b.min * 0.5 + b.max * 0.5;
-    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-    for (_, b) in items.iter() {
-        lo = lo.min(centre(b));
-        hi = hi.max(centre(b));
+/// A box's centre (`min/2 + max/2`, which cannot overflow) and its index: 16 bytes, what a
+/// build moves.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Centre([f32; 3], u32);
+
+/// Reorders `centres` so that the first `mid` are the smallest along the axis where they
+/// spread widest.
+fn split_at_median(centres: &mut [Centre], mid: usize) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for c in centres.iter() {
+        for a in 0..3 {
+            lo[a] = lo[a].min(c.0[a]);
+            hi[a] = hi[a].max(c.0[a]);
+        }
     }
-    let spread = hi - lo;
-    let axis = if spread.x >= spread.y && spread.x >= spread.z {
+    // The spreads in `f64`, where they cannot overflow.
+    let spread = [0, 1, 2].map(|a| f64::from(hi[a]) - f64::from(lo[a]));
+    let axis = if spread[0] >= spread[1] && spread[0] >= spread[2] {
         0
-    } else if spread.y >= spread.z {
+    } else if spread[1] >= spread[2] {
         1
     } else {
         2
     };
-    items.select_nth_unstable_by(mid, |a, b| {
-        centre(&a.1)[axis].total_cmp(&centre(&b.1)[axis])
-    });
+    centres.select_nth_unstable_by(mid, |a, b| a.0[axis].total_cmp(&b.0[axis]));
 }

@@ -206,7 +206,7 @@ fn accepts(b: &Aabb3) -> bool {
 }
 
 /// A dynamic tree of fat boxes, fed by the moved set (see the [module docs](self)).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct DynamicTree {
     awake: Hierarchy,
     asleep: Hierarchy,
@@ -220,10 +220,35 @@ pub struct DynamicTree {
     /// Proxies refused since the last report.
     refused: Vec<u32>,
     len: usize,
+    /// Per hierarchy (awake, asleep): its proxies, and the moves and inserts since its build.
+    sizes: [usize; 2],
+    moves: [u64; 2],
+    /// [`DynamicTree::set_rebuild_after`].
+    rebuild_after: f32,
     /// Scratch: the moved boxes, an order of them or of the changes, the query stack.
     fresh: Vec<(u32, Aabb3)>,
     order: Vec<u64>,
     stack: Vec<u32>,
+}
+
+impl Default for DynamicTree {
+    fn default() -> Self {
+        Self {
+            awake: Hierarchy::default(),
+            asleep: Hierarchy::default(),
+            at: Vec::new(),
+            mark: Vec::new(),
+            pending: Vec::new(),
+            refused: Vec::new(),
+            len: 0,
+            sizes: [0; 2],
+            moves: [0; 2],
+            rebuild_after: 16.0,
+            fresh: Vec::new(),
+            order: Vec::new(),
+            stack: Vec::new(),
+        }
+    }
 }
 
 impl DynamicTree {
@@ -261,10 +286,11 @@ impl DynamicTree {
                 .map(|id| Change::new(id, &Aabb3::EMPTY))
                 .collect(),
             len,
+            sizes: [len, 0],
             ..Self::default()
         };
         let (h, mut places) = tree.hierarchy(false);
-        *h = Hierarchy::build(&mut items, &mut places);
+        h.build(items, &mut places);
         Ok(tree)
     }
 
@@ -364,12 +390,15 @@ impl DynamicTree {
         let asleep = at & ASLEEP != 0;
         let (h, _) = self.hierarchy(asleep);
         h.remove(Slot(at & !ASLEEP));
+        self.sizes[usize::from(asleep)] -= 1;
         asleep
     }
 
     fn place(&mut self, id: u32, b: &Aabb3, asleep: bool) {
         let (h, mut places) = self.hierarchy(asleep);
         h.insert(id, b, &mut places);
+        self.sizes[usize::from(asleep)] += 1;
+        self.moves[usize::from(asleep)] += 1;
     }
 
     /// Adds proxy `id` (awake) with fat box `fat`; its pairs begin at the next report.
@@ -434,9 +463,9 @@ impl DynamicTree {
     pub fn rebuild(&mut self) {
         for asleep in [false, true] {
             let (h, mut places) = self.hierarchy(asleep);
-            let mut items = h.proxies();
-            *h = Hierarchy::build(&mut items, &mut places);
+            h.rebuild(&mut places);
         }
+        self.moves = [0; 2];
     }
 
     /// Calls `hit(id)` for every placed proxy whose fat box overlaps `b` (closed boxes).
@@ -479,14 +508,41 @@ impl DynamicTree {
         pairs: &mut Pairs,
     ) -> Result<(), BroadphaseError> {
         self.write(moved, fat)?;
+        self.maintain();
         self.report(pairs);
         Ok(())
     }
 
+    /// Sets when [`DynamicTree::maintain`] rebuilds a hierarchy: once it has taken this
+    /// many moves and inserts per proxy since its last build (default 16; `f32::INFINITY`
+    /// never, leaving [`DynamicTree::rebuild`] to the caller).
+    pub fn set_rebuild_after(&mut self, moves_per_proxy: f32) {
+        self.rebuild_after = moves_per_proxy;
+    }
+
+    /// The tree's upkeep, between [`DynamicTree::write`] and [`DynamicTree::report`]: moves
+    /// leave node boxes loose and mix distant proxies under one node, so a hierarchy that
+    /// has taken enough moves since its last build (see [`DynamicTree::set_rebuild_after`])
+    /// is rebuilt. Returns whether one was. Boxes and pairs do not change.
+    pub fn maintain(&mut self) -> bool {
+        let mut rebuilt = false;
+        for asleep in [false, true] {
+            let h = usize::from(asleep);
+            let budget = self.rebuild_after * self.sizes[h].max(1) as f32;
+            if self.moves[h] as f32 > budget {
+                let (hierarchy, mut places) = self.hierarchy(asleep);
+                hierarchy.rebuild(&mut places);
+                self.moves[h] = 0;
+                rebuilt = true;
+            }
+        }
+        rebuilt
+    }
+
     /// The tree's half of a frame: the proxies in `moved` (strictly ascending ids, as
     /// [`Moved::indices`](crate::Moved::indices)) take their boxes from `fat` (indexed by id,
-    /// in any box layout the batch writes), and each change is carried up the tree while a
-    /// parent's box changes. Moved ids not in the tree are ignored; a refused box parks its
+    /// in any box layout the batch writes), and each enlarges the boxes above it up to the
+    /// first that already contains it. Moved ids not in the tree are ignored; a refused box parks its
     /// proxy (module docs). The pairs wait for [`DynamicTree::report`].
     ///
     /// # Errors
@@ -543,8 +599,10 @@ impl DynamicTree {
             if at == PARKED {
                 self.place(id, b, false);
             } else {
-                let (h, _) = self.hierarchy(at & ASLEEP != 0);
+                let asleep = at & ASLEEP != 0;
+                let (h, _) = self.hierarchy(asleep);
                 h.set(Slot(at & !ASLEEP), b);
+                self.moves[usize::from(asleep)] += 1;
             }
         } else {
             self.refused.push(id);
