@@ -3,9 +3,13 @@
 //!
 //! [`DynamicTree`] holds one proxy per body, keyed by the body's index in the slices a
 //! [`Batch::update`](crate::Batch::update) reads, with the body's fat box. Each frame the
-//! engine hands it [`Moved::indices`](crate::Moved::indices) and the fat boxes; the tree
-//! rewrites the moved proxies' boxes, carries each change up only while a parent's box
-//! changes, and searches pairs only from the moved proxies:
+//! engine hands it [`Moved::indices`](crate::Moved::indices) and the fat boxes, and
+//! [`DynamicTree::update`] runs the frame's three steps (each also callable alone):
+//! [`write`](DynamicTree::write) rewrites the moved proxies' boxes, enlarging the nodes
+//! above each up to the first that already holds it; [`maintain`](DynamicTree::maintain)
+//! rebuilds a hierarchy once enough has moved since its last build;
+//! [`report`](DynamicTree::report) searches pairs only from the proxies changed since the
+//! last report:
 //!
 //! ```
 //! use bvkit::broadphase::{DynamicTree, Pairs};
@@ -42,11 +46,12 @@
 //! boxes overlap now (closed boxes: touching counts) and did not at the last report, and
 //! *ends* the other way round; a body inserted, removed or parked since counts as having
 //! had, or having, no box. This is exact: the tree loses no pair and invents none, whatever
-//! moved, because its node boxes are exact unions (`min`/`max` round nothing), and the
-//! tests check every frame against all pairs by brute force.
+//! moved, because a node's box always contains its children's (`min`/`max` round nothing)
+//! and each pair's verdict compares the two boxes themselves; the tests and a fuzz target
+//! check every report against all pairs by brute force.
 //!
 //! **Bad boxes.** A NaN, infinite or inverted box is refused: [`DynamicTree::insert`]
-//! returns an error, and [`DynamicTree::update`] *parks* the proxy (it leaves the tree, its
+//! returns an error, and [`DynamicTree::write`] *parks* the proxy (it leaves the tree, its
 //! pairs end, and its id is listed in [`Pairs::refused`]) until a later update gives it a
 //! finite box. No such box ever reaches a node, so no later query or rebuild meets one.
 //!
