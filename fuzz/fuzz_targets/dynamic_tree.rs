@@ -1,8 +1,9 @@
 //! The broadphase's dynamic tree against a brute-force reference, over any sequence of
-//! inserts, removes, moves (`write`), reports, sleeps, wakes, rebuilds and upkeep (`maintain`),
+//! inserts, removes, moves (`write`), reports, queries, rebuilds and upkeep (`maintain`),
 //! with any boxes: small integer boxes that overlap often, and faces of any bits (NaN, ±∞, ±MAX,
 //! subnormals). After every operation the tree holds what the reference holds (placed,
-//! parked or absent, asleep or awake, and each box bit for bit); every report's begun and
+//! parked or absent, and each box bit for bit); every query finds the placed boxes it
+//! overlaps; every report's begun and
 //! ended pairs are exactly the differences of the brute-force pair sets since the last
 //! report, and its refused ids are the moves whose boxes the reference refuses. Nothing
 //! panics.
@@ -77,7 +78,6 @@ fuzz_target!(|data: &[u8]| {
     let mut f = Floats::new(data);
     let mut tree = DynamicTree::new();
     let mut proxies = [Proxy::Absent; IDS];
-    let mut asleep = [false; IDS];
     let mut fat = vec![Aabb3::EMPTY; IDS];
     let mut last = BTreeSet::new();
     let mut refused: BTreeSet<u32> = BTreeSet::new();
@@ -99,7 +99,6 @@ fuzz_target!(|data: &[u8]| {
                 } else {
                     assert_eq!(got, Ok(()));
                     proxies[id as usize] = Proxy::Placed(b);
-                    asleep[id as usize] = false;
                 }
             }
             1 => {
@@ -122,9 +121,6 @@ fuzz_target!(|data: &[u8]| {
                     }
                     let b = fat[id as usize];
                     if accepted(&b) {
-                        if *p == Proxy::Parked {
-                            asleep[id as usize] = false;
-                        }
                         *p = Proxy::Placed(b);
                     } else {
                         *p = Proxy::Parked;
@@ -133,18 +129,17 @@ fuzz_target!(|data: &[u8]| {
                 }
             }
             3 | 4 => {
-                let sleep = op == 3;
-                let list = ids(&mut f);
-                if sleep {
-                    tree.sleep(&list);
-                } else {
-                    tree.wake(&list);
-                }
-                for id in list {
-                    if matches!(proxies[id as usize], Proxy::Placed(_)) {
-                        asleep[id as usize] = sleep;
-                    }
-                }
+                // A query with any box: the placed proxies it overlaps (none for a box
+                // with a NaN face or an inverted one).
+                let q = boxed(&mut f);
+                let mut got = BTreeSet::new();
+                tree.query(&q, |id| {
+                    got.insert(id);
+                });
+                let expected: BTreeSet<u32> = (0..IDS as u32)
+                    .filter(|&i| matches!(proxies[i as usize], Proxy::Placed(b) if overlap(&q, &b)))
+                    .collect();
+                assert_eq!(got, expected, "query {q:?}");
             }
             5 => {
                 if f.byte() % 2 == 0 {
@@ -181,9 +176,6 @@ fuzz_target!(|data: &[u8]| {
                 (Proxy::Placed(b), Some(g)) => assert!(same(&b, &g), "proxy {id}: box"),
                 (Proxy::Placed(_), None) => panic!("proxy {id} lost"),
                 (_, got) => assert!(got.is_none(), "proxy {id}: a box it should not have"),
-            }
-            if matches!(p, Proxy::Placed(_)) {
-                assert_eq!(tree.is_asleep(id), asleep[id as usize], "proxy {id}: sleep");
             }
         }
         let count = proxies.iter().filter(|p| **p != Proxy::Absent).count();

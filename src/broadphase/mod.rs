@@ -55,9 +55,10 @@
 //! pairs end, and its id is listed in [`Pairs::refused`]) until a later update gives it a
 //! finite box. No such box ever reaches a node, so no later query or rebuild meets one.
 //!
-//! **Sleep.** Sleeping proxies live in a second hierarchy: the awake one, which every moved
-//! proxy rewrites, stays the size of the awake set. Pairs between the two are found as any
-//! other (a moved proxy queries both).
+//! **Sleep.** Sleeping bodies need no call: they are not in the update's moved list, so
+//! their proxies stay as they are, their pairs last, and a moved proxy finds them as any
+//! other. (A second hierarchy for the sleeping proxies was measured and dropped: every
+//! moved proxy must query both, which cost more than the smaller rebuilds saved.)
 
 mod hierarchy;
 
@@ -160,10 +161,9 @@ impl Pairs {
     }
 }
 
-/// Where a proxy is: nowhere, parked, or a slot of one of the two hierarchies.
+/// Where a proxy is: nowhere, parked, or a slot.
 const ABSENT: u32 = u32::MAX;
 const PARKED: u32 = u32::MAX - 1;
-const ASLEEP: u32 = 1 << 31;
 /// Ids are packed in 31 bits, with the two codes above kept out of range.
 const MAX_ID: u32 = (1 << 31) - 2;
 
@@ -192,16 +192,15 @@ impl Change {
     }
 }
 
-/// Sends a hierarchy's proxy moves to the per-proxy places.
+/// Sends the hierarchy's proxy moves to the per-proxy places.
 struct Placer<'a> {
     at: &'a mut [u32],
-    asleep: bool,
 }
 
 impl Places for Placer<'_> {
     #[inline(always)]
     fn place(&mut self, id: u32, slot: Slot) {
-        self.at[id as usize] = slot.0 | if self.asleep { ASLEEP } else { 0 };
+        self.at[id as usize] = slot.0;
     }
 }
 
@@ -213,9 +212,8 @@ fn accepts(b: &Aabb3) -> bool {
 /// A dynamic tree of fat boxes, fed by the moved set (see the [module docs](self)).
 #[derive(Clone, Debug)]
 pub struct DynamicTree {
-    awake: Hierarchy,
-    asleep: Hierarchy,
-    /// Per id: [`ABSENT`], [`PARKED`], or a slot (with [`ASLEEP`] in the asleep hierarchy).
+    hierarchy: Hierarchy,
+    /// Per id: [`ABSENT`], [`PARKED`], or a slot.
     at: Vec<u32>,
     /// Per id: 1 + its index in `pending`, 0 when it has not changed since the last report.
     mark: Vec<u32>,
@@ -225,9 +223,8 @@ pub struct DynamicTree {
     /// Proxies refused since the last report.
     refused: Vec<u32>,
     len: usize,
-    /// Per hierarchy (awake, asleep): its proxies, and the moves and inserts since its build.
-    sizes: [usize; 2],
-    moves: [u64; 2],
+    /// The moves and inserts since the last build.
+    moves: u64,
     /// [`DynamicTree::set_rebuild_after`].
     rebuild_after: f32,
     /// Scratch: the moved boxes, an order of them or of the changes, the query stack.
@@ -239,15 +236,13 @@ pub struct DynamicTree {
 impl Default for DynamicTree {
     fn default() -> Self {
         Self {
-            awake: Hierarchy::default(),
-            asleep: Hierarchy::default(),
+            hierarchy: Hierarchy::default(),
             at: Vec::new(),
             mark: Vec::new(),
             pending: Vec::new(),
             refused: Vec::new(),
             len: 0,
-            sizes: [0; 2],
-            moves: [0; 2],
+            moves: 0,
             rebuild_after: 16.0,
             fresh: Vec::new(),
             order: Vec::new(),
@@ -263,7 +258,7 @@ impl DynamicTree {
         Self::default()
     }
 
-    /// A tree whose proxy `i` is awake with box `i` of `fat`, built balanced (as
+    /// A tree whose proxy `i` has box `i` of `fat`, built balanced (as
     /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first report.
     ///
     /// # Errors
@@ -291,10 +286,9 @@ impl DynamicTree {
                 .map(|id| Change::new(id, &Aabb3::EMPTY))
                 .collect(),
             len,
-            sizes: [len, 0],
             ..Self::default()
         };
-        let (h, mut places) = tree.hierarchy(false);
+        let (h, mut places) = tree.parts();
         h.build(items, &mut places);
         Ok(tree)
     }
@@ -317,8 +311,7 @@ impl DynamicTree {
         let at = *self.at.get(id as usize)?;
         match at {
             ABSENT | PARKED => None,
-            at if at & ASLEEP != 0 => Some(self.asleep.get(Slot(at & !ASLEEP))),
-            at => Some(self.awake.get(Slot(at))),
+            at => Some(self.hierarchy.get(Slot(at))),
         }
     }
 
@@ -334,18 +327,10 @@ impl DynamicTree {
         self.at.get(id as usize) == Some(&PARKED)
     }
 
-    /// True when proxy `id` is asleep.
-    #[must_use]
-    pub fn is_asleep(&self, id: u32) -> bool {
-        self.at
-            .get(id as usize)
-            .is_some_and(|&at| at != ABSENT && at != PARKED && at & ASLEEP != 0)
-    }
-
-    /// The nodes of the two hierarchies (8 children each, 256 bytes).
+    /// The tree's nodes (8 children each, 256 bytes).
     #[must_use]
     pub fn nodes(&self) -> usize {
-        self.awake.nodes() + self.asleep.nodes()
+        self.hierarchy.nodes()
     }
 
     fn grow(&mut self, id: u32) -> Result<(), BroadphaseError> {
@@ -374,39 +359,23 @@ impl DynamicTree {
         }
     }
 
-    fn hierarchy(&mut self, asleep: bool) -> (&mut Hierarchy, Placer<'_>) {
-        let h = if asleep {
-            &mut self.asleep
-        } else {
-            &mut self.awake
-        };
-        (
-            h,
-            Placer {
-                at: &mut self.at,
-                asleep,
-            },
-        )
+    /// The hierarchy, and where its proxy moves go.
+    fn parts(&mut self) -> (&mut Hierarchy, Placer<'_>) {
+        (&mut self.hierarchy, Placer { at: &mut self.at })
     }
 
-    /// Takes placed proxy `id` out of its hierarchy; returns whether it was asleep.
-    fn take_out(&mut self, id: u32) -> bool {
-        let at = self.at[id as usize];
-        let asleep = at & ASLEEP != 0;
-        let (h, _) = self.hierarchy(asleep);
-        h.remove(Slot(at & !ASLEEP));
-        self.sizes[usize::from(asleep)] -= 1;
-        asleep
+    /// Takes placed proxy `id` out of the hierarchy.
+    fn take_out(&mut self, id: u32) {
+        self.hierarchy.remove(Slot(self.at[id as usize]));
     }
 
-    fn place(&mut self, id: u32, b: &Aabb3, asleep: bool) {
-        let (h, mut places) = self.hierarchy(asleep);
+    fn place(&mut self, id: u32, b: &Aabb3) {
+        let (h, mut places) = self.parts();
         h.insert(id, b, &mut places);
-        self.sizes[usize::from(asleep)] += 1;
-        self.moves[usize::from(asleep)] += 1;
+        self.moves += 1;
     }
 
-    /// Adds proxy `id` (awake) with fat box `fat`; its pairs begin at the next report.
+    /// Adds proxy `id` with fat box `fat`; its pairs begin at the next report.
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
@@ -421,7 +390,7 @@ impl DynamicTree {
             return Err(BroadphaseError::Duplicate { id });
         }
         self.note(id);
-        self.place(id, &fat, false);
+        self.place(id, &fat);
         self.len += 1;
         Ok(())
     }
@@ -441,44 +410,18 @@ impl DynamicTree {
         true
     }
 
-    /// Moves the awake proxies among `ids` to the asleep hierarchy (an island going to
-    /// sleep); their boxes and pairs do not change. Other ids are ignored.
-    pub fn sleep(&mut self, ids: &[u32]) {
-        self.move_between(ids, true);
-    }
-
-    /// Moves the asleep proxies among `ids` back to the awake hierarchy.
-    pub fn wake(&mut self, ids: &[u32]) {
-        self.move_between(ids, false);
-    }
-
-    fn move_between(&mut self, ids: &[u32], to_asleep: bool) {
-        for &id in ids {
-            let Some(b) = self.get(id) else { continue };
-            if self.is_asleep(id) != to_asleep {
-                self.take_out(id);
-                self.place(id, &b, to_asleep);
-            }
-        }
-    }
-
-    /// Rebuilds both hierarchies from their proxies, balanced (median splits of the widest
-    /// spread of centres). Boxes and pairs do not change; queries get faster where moves
-    /// have mixed distant proxies under one node.
+    /// Rebuilds the tree from its proxies, balanced (median splits of the widest spread of
+    /// centres). Boxes and pairs do not change; queries get faster where moves have left
+    /// node boxes loose or mixed distant proxies under one node.
     pub fn rebuild(&mut self) {
-        for asleep in [false, true] {
-            let (h, mut places) = self.hierarchy(asleep);
-            h.rebuild(&mut places);
-        }
-        self.moves = [0; 2];
+        let (h, mut places) = self.parts();
+        h.rebuild(&mut places);
+        self.moves = 0;
     }
 
     /// Calls `hit(id)` for every placed proxy whose fat box overlaps `b` (closed boxes).
     pub fn query(&self, b: &Aabb3, mut hit: impl FnMut(u32)) {
-        let mut stack = Vec::new();
-        for h in [&self.awake, &self.asleep] {
-            h.query(b, &mut stack, |id, _| hit(id));
-        }
+        self.hierarchy.query(b, &mut Vec::new(), |id, _| hit(id));
     }
 
     /// Every pair of placed proxies whose fat boxes overlap, as `(smaller, larger)`,
@@ -487,16 +430,12 @@ impl DynamicTree {
     pub fn overlapping_pairs(&self) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
         let mut stack = Vec::new();
-        for h in [&self.awake, &self.asleep] {
-            for (id, b) in h.proxies() {
-                for g in [&self.awake, &self.asleep] {
-                    g.query(&b, &mut stack, |other, _| {
-                        if other > id {
-                            out.push((id, other));
-                        }
-                    });
+        for (id, b) in self.hierarchy.proxies() {
+            self.hierarchy.query(&b, &mut stack, |other, _| {
+                if other > id {
+                    out.push((id, other));
                 }
-            }
+            });
         }
         out.sort_unstable();
         out
@@ -518,30 +457,25 @@ impl DynamicTree {
         Ok(())
     }
 
-    /// Sets when [`DynamicTree::maintain`] rebuilds a hierarchy: once it has taken this
-    /// many moves and inserts per proxy since its last build (default 16; `f32::INFINITY`
+    /// Sets when [`DynamicTree::maintain`] rebuilds the tree: once it has taken this many
+    /// moves and inserts per proxy since its last build (default 16; `f32::INFINITY`
     /// never, leaving [`DynamicTree::rebuild`] to the caller).
     pub fn set_rebuild_after(&mut self, moves_per_proxy: f32) {
         self.rebuild_after = moves_per_proxy;
     }
 
     /// The tree's upkeep, between [`DynamicTree::write`] and [`DynamicTree::report`]: moves
-    /// leave node boxes loose and mix distant proxies under one node, so a hierarchy that
-    /// has taken enough moves since its last build (see [`DynamicTree::set_rebuild_after`])
-    /// is rebuilt. Returns whether one was. Boxes and pairs do not change.
+    /// leave node boxes loose and mix distant proxies under one node, so the tree is rebuilt
+    /// once it has taken enough moves since its last build (see
+    /// [`DynamicTree::set_rebuild_after`]). Returns whether it was. Boxes and pairs do not
+    /// change.
     pub fn maintain(&mut self) -> bool {
-        let mut rebuilt = false;
-        for asleep in [false, true] {
-            let h = usize::from(asleep);
-            let budget = self.rebuild_after * self.sizes[h].max(1) as f32;
-            if self.moves[h] as f32 > budget {
-                let (hierarchy, mut places) = self.hierarchy(asleep);
-                hierarchy.rebuild(&mut places);
-                self.moves[h] = 0;
-                rebuilt = true;
-            }
+        let proxies = self.len.max(1) as f32;
+        let rebuild = self.moves as f32 > self.rebuild_after * proxies;
+        if rebuild {
+            self.rebuild();
         }
-        rebuilt
+        rebuild
     }
 
     /// The tree's half of a frame: the proxies in `moved` (strictly ascending ids, as
@@ -587,12 +521,7 @@ impl DynamicTree {
             && at != ABSENT
             && at != PARKED
         {
-            let h = if at & ASLEEP != 0 {
-                &self.asleep
-            } else {
-                &self.awake
-            };
-            h.prefetch(Slot(at & !ASLEEP));
+            self.hierarchy.prefetch(Slot(at));
         }
     }
 
@@ -602,12 +531,10 @@ impl DynamicTree {
         let at = self.at[id as usize];
         if accepts(b) {
             if at == PARKED {
-                self.place(id, b, false);
+                self.place(id, b);
             } else {
-                let asleep = at & ASLEEP != 0;
-                let (h, _) = self.hierarchy(asleep);
-                h.set(Slot(at & !ASLEEP), b);
-                self.moves[usize::from(asleep)] += 1;
+                self.hierarchy.set(Slot(at), b);
+                self.moves += 1;
             }
         } else {
             self.refused.push(id);
@@ -635,7 +562,7 @@ impl DynamicTree {
         let ended = pairs.ended_wanted;
         let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
-            hierarchies: [&self.awake, &self.asleep],
+            hierarchy: &self.hierarchy,
             mark: &self.mark,
         };
         let stack = &mut self.stack;
@@ -656,9 +583,9 @@ impl DynamicTree {
     }
 }
 
-/// What a report reads: the two hierarchies and the change marks.
+/// What a report reads: the hierarchy and the change marks.
 struct View<'a> {
-    hierarchies: [&'a Hierarchy; 2],
+    hierarchy: &'a Hierarchy,
     mark: &'a [u32],
 }
 
@@ -686,20 +613,18 @@ impl View<'_> {
     fn at(&self, at: u32) -> Aabb3 {
         match at {
             ABSENT | PARKED => Aabb3::EMPTY,
-            at => self.hierarchies[usize::from(at & ASLEEP != 0)].get(Slot(at & !ASLEEP)),
+            at => self.hierarchy.get(Slot(at)),
         }
     }
 
     /// Calls `hit(id, box)` for every placed proxy whose box overlaps `q`.
     #[inline(always)]
     fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
-        for h in self.hierarchies {
-            h.query(q, stack, &mut hit);
-        }
+        self.hierarchy.query(q, stack, &mut hit);
     }
 }
 
-/// The begun pairs: each changed proxy's new box against both hierarchies. A pair of two
+/// The begun pairs: each changed proxy's new box against the tree. A pair of two
 /// changed proxies is taken from the larger id's query, and began when their old boxes did
 /// not overlap; a pair with an unchanged proxy began when the changed one's old box did not
 /// overlap the other's (unchanged) box.
@@ -732,7 +657,7 @@ fn search(
     }
 }
 
-/// The ended pairs: each changed proxy's old box against both hierarchies for the unchanged
+/// The ended pairs: each changed proxy's old box against the tree for the unchanged
 /// proxies (whose boxes are as they were), and a sweep over the old boxes of the changed
 /// ones for the pairs of two changed proxies.
 #[inline(always)]
