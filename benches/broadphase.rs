@@ -266,6 +266,7 @@ fn pipelines(c: &mut Criterion) {
             ("B", bvh::Tuning::default(), 1),
             ("B-relative-0.3", relative, 1),
             ("C", bvh::Tuning::default(), 2),
+            ("D", bvh::Tuning::default(), 3),
         ] {
             for (k, stage) in STAGES.iter().enumerate() {
                 // Every benchmark from the same first frame, so that each one times the

@@ -343,6 +343,7 @@ impl Hierarchy {
                 if c & LEAF != 0 {
                     hit(c & !LEAF, &node.get(k));
                 } else {
+                    // Asked for now: its siblings' subtrees run first, or the next pop.
                     stack.push(c);
                 }
             }

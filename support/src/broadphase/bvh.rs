@@ -1,4 +1,5 @@
-//! Two broadphase pipelines on one scene, each on its own parry3d `Bvh`, frame by frame.
+//! Four broadphase pipelines on one scene, each on its own tree, frame by frame: A and B on
+//! parry3d's `Bvh`, C on bvkit's `DynamicTree`, D on obvhs's `Bvh2` (the tree avian uses).
 //!
 //! - A, as rapier runs it: every awake body's world box (`Aabb::transform_by`), each into
 //!   the tree with `insert_or_update_partially(box, body, margin)` (a leaf changes only when
@@ -10,6 +11,13 @@
 //!   margin, so the tree adds none; parry marks a leaf changed only under a positive margin,
 //!   so B passes the smallest normal `f32`, which moves a face by at most `2^-126` (and not
 //!   at all where `|face| >= 2^-102`).
+//!
+//! - C, bvkit's own: the same update (into its own fat boxes and moved set), then
+//!   `DynamicTree::write` of the moved proxies (the leaves, their paths enlarged: the
+//!   "leaves" column), `maintain` (a rebuild once enough has moved: "optim") and `report`
+//!   (the pairs that began, searched from the moved proxies: "pairs").
+//! - D, obvhs: C's fat boxes and moved list (its box stage is C's) into `obvhs::ObvhsTree`
+//!   (see `obvhs.rs` for the upkeep obvhs advises); its pairs are the begun ones too.
 //!
 //! Two options of B's (`Tuning`) test what bvkit can take off the tree's work:
 //! - `--relative R`: B's fat boxes also grow each face by `R` times the box's half-extent
@@ -39,6 +47,7 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
 
+use super::obvhs::ObvhsTree;
 use super::scene::Scene;
 use crate::common::cpu;
 
@@ -204,6 +213,8 @@ pub struct Pipelines {
     b: Tree,
     /// C: bvkit's update (its own fat boxes and moved set, as B's) into bvkit's tree.
     c: Dynamic,
+    /// D: the same update's fat boxes and moved list (C's) into obvhs's `Bvh2`.
+    d: ObvhsTree,
     tuning: Tuning,
     /// Frames run, and A's rewritten leaves in this one.
     frames: usize,
@@ -249,16 +260,10 @@ impl Pipelines {
         let mut mask8 = scene.mask.clone();
         mask8.resize((8 * local8.len()).div_ceil(64), 0);
         let mut tree = DynamicTree::from_boxes(&fat[..]).expect("finite fat boxes");
-        // The sleeping islands go to the tree's asleep hierarchy, as an engine would put
-        // them there when they fall asleep.
-        let asleep: Vec<u32> = (0..n as u32)
-            .filter(|&i| scene.mask[i as usize / 64] >> (i % 64) & 1 == 0)
-            .collect();
-        tree.sleep(&asleep);
-        tree.rebuild();
         let mut pairs = Pairs::new();
         // The first report: every overlapping pair begins.
         tree.report(&mut pairs);
+        let d = ObvhsTree::new(&Aabb3x8::unpack(&fat, n));
         let c = Dynamic {
             fat: fat.clone(),
             moved: Moved::new(),
@@ -280,14 +285,15 @@ impl Pipelines {
             moved,
             b,
             c,
+            d,
             tuning,
             frames: 0,
             rewritten: Vec::new(),
         }
     }
 
-    /// One frame of each pipeline (A, B, C) on the scene's current poses.
-    pub fn frame(&mut self, scene: &Scene) -> [Frame; 3] {
+    /// One frame of each pipeline (A, B, C, D) on the scene's current poses.
+    pub fn frame(&mut self, scene: &Scene) -> [Frame; 4] {
         for i in scene.awake() {
             self.poses[i] = pose(&scene.poses[i]);
             self.poses8[i / 8].set(i % 8, scene.poses[i]);
@@ -368,7 +374,18 @@ impl Pipelines {
         fc.ms[4] = ms(start);
         fc.rewritten = c.moved.len();
         fc.pairs = c.pairs.begun.len();
-        [fa, fb, fc]
+
+        // D reads C's update (the same call would do the same work), so its box stage is
+        // C's.
+        let mut fd = Frame::default();
+        fd.ms[0] = fc.ms[0];
+        let fat = &c.fat;
+        self.d.frame(
+            c.moved.indices(),
+            |i| fat[i as usize / 8].get(i as usize % 8),
+            &mut fd,
+        );
+        [fa, fb, fc, fd]
     }
 
     /// Checks C's last report against a sweep over its fat boxes: the pairs that began are
@@ -394,7 +411,7 @@ impl Pipelines {
 /// What a run measured: the mean frame of each pipeline (ms) and, over the frames checked,
 /// the pairs C's reports missed and had wrongly.
 pub struct Summary {
-    pub frame: [f64; 3],
+    pub frame: [f64; 4],
     pub missing: usize,
     pub wrong: usize,
     pub checked: usize,
@@ -441,15 +458,17 @@ pub fn run(
         .join(" ")
     };
     println!(
-        "{:>5} | {} | {} | {} | {:>6} {:>6}",
+        "{:>5} | {} | {} | {} | {} | {:>6} {:>6} {:>6}",
         "frame",
         columns("A boxes"),
         columns("B update"),
         columns("C update"),
+        columns("D update"),
         "B/A",
-        "C/A"
+        "C/A",
+        "D/A"
     );
-    let mut sum = [Frame::default(); 3];
+    let mut sum = [Frame::default(); 4];
     // Over the checked frames: overlapping world boxes, and leaf pairs of one tree only.
     let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
     let (mut missing, mut wrong) = (0, 0);
@@ -525,7 +544,7 @@ pub fn run(
     }
 }
 
-fn print_frame(label: &str, f: &[Frame; 3]) {
+fn print_frame(label: &str, f: &[Frame; 4]) {
     let cells = |x: &Frame| {
         let mut c: Vec<String> = x.ms.iter().map(|v| format!("{v:>8.3}")).collect();
         c.push(format!("{:>8.3}", x.total()));
@@ -534,11 +553,13 @@ fn print_frame(label: &str, f: &[Frame; 3]) {
         c.join(" ")
     };
     println!(
-        "{label:>5} | {} | {} | {} | {:>5.2}× {:>5.2}×",
+        "{label:>5} | {} | {} | {} | {} | {:>5.2}× {:>5.2}× {:>5.2}×",
         cells(&f[0]),
         cells(&f[1]),
         cells(&f[2]),
+        cells(&f[3]),
         f[1].total() / f[0].total(),
-        f[2].total() / f[0].total()
+        f[2].total() / f[0].total(),
+        f[3].total() / f[0].total()
     );
 }
