@@ -343,7 +343,6 @@ impl Hierarchy {
                 if c & LEAF != 0 {
                     hit(c & !LEAF, &node.get(k));
                 } else {
-                    // Asked for now: its siblings' subtrees run first, or the next pop.
                     stack.push(c);
                 }
             }
