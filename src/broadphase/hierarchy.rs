@@ -202,6 +202,17 @@ impl Hierarchy {
         }
     }
 
+    /// Asks for the cache lines of the parent of `slot`'s node (reading the node's parent
+    /// field, so best once the node itself was asked for).
+    #[inline(always)]
+    pub(crate) fn prefetch_parent(&self, slot: Slot) {
+        if let Some(node) = self.nodes.get(slot.node() as usize)
+            && node.parent.0 != NONE
+        {
+            self.prefetch(node.parent);
+        }
+    }
+
     /// The number of nodes in use.
     pub(crate) fn nodes(&self) -> usize {
         self.nodes.len() - self.free.len()
