@@ -605,8 +605,18 @@ fn in_order<'c>(
 ) -> impl Iterator<Item = (&'c Change, Aabb3)> + 'c {
     const AHEAD: usize = 8;
     order.iter().enumerate().map(move |(k, &key)| {
+        if let Some(&next) = order.get(k + 2 * AHEAD) {
+            let at = (next >> 32) as u32;
+            if at != ABSENT && at != PARKED {
+                view.hierarchy.prefetch(Slot(at));
+            }
+        }
         if let Some(&next) = order.get(k + AHEAD) {
             crate::simd::prefetch(&changes[next as u32 as usize]);
+            let at = (next >> 32) as u32;
+            if at != ABSENT && at != PARKED {
+                view.hierarchy.prefetch_parent(Slot(at));
+            }
         }
         (&changes[key as u32 as usize], view.at((key >> 32) as u32))
     })
