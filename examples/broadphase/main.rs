@@ -9,10 +9,11 @@
 //!   fat box moved and the fat boxes rewritten. After every frame it checks what the update
 //!   promises in each layout: every fat box contains its body's tight box.
 //! - `cargo run --release --features peers --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
-//!   [--partial K]`: two whole broadphase pipelines on parry3d's `Bvh` (see `bvh.rs`), stage
-//!   by stage; the options tune bvkit's pipeline. A third pipeline, C, runs bvkit's update
-//!   into bvkit's own `broadphase::DynamicTree`.
-//! - `cargo run --release --features peers --example broadphase tree [T]`: the three
+//!   [--partial K]`: four whole broadphase pipelines (see `bvh.rs`), stage by stage: A and
+//!   B on parry3d's `Bvh` (rapier's, and fed by bvkit's update; the options tune B), C on
+//!   bvkit's own `broadphase::DynamicTree`, D on obvhs's `Bvh2`. Up to 20K bodies it checks
+//!   C's begun pairs every frame against a sweep, and fails on any difference.
+//! - `cargo run --release --features peers --example broadphase tree [T]`: the four
 //!   pipelines on the two scenes of issue 47 (1M bodies half asleep, 100K all awake), T
 //!   frames each (default 100, so that the means include the tree's rebuilds at 1M), C's begun pairs checked every frame against a sweep; the
 //!   last line reads `frame_vs_rapier_1m=R1 frame_vs_rapier_100k=R2 missing_pairs=M`.
@@ -55,7 +56,13 @@ fn main() {
     if mode.as_deref() == Some("tree") {
         tree(arg(0, 100.0) as usize, tuning);
     } else if mode.is_some() {
-        bvh::run(n, frames, asleep, island, tuning, false);
+        // Small scenes also check C's reports every frame, and fail on any error.
+        let summary = bvh::run(n, frames, asleep, island, tuning, n <= 20_000);
+        assert_eq!(
+            summary.missing + summary.wrong,
+            0,
+            "C's begun pairs differ from the sweep's"
+        );
     } else {
         update_against_naive(n, frames, asleep, island);
     }
