@@ -6,7 +6,7 @@
 use std::collections::BTreeSet;
 
 use bvkit::broadphase::{BroadphaseError, DynamicTree, Pairs};
-use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
+use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
 use glam::{Quat, Vec3A};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -196,7 +196,38 @@ fn begun_pairs_alone_match_the_reference() {
     let now = brute_force(&next, &member);
     assert!(!now.is_empty());
     assert_eq!(as_set(&pairs.begun), now);
-    assert!(pairs.ended.is_empty());
+    // And back: every pair ends, which a begun-only report leaves out.
+    tree.update(&odd, &start, &mut pairs).unwrap();
+    assert!(pairs.begun.is_empty() && pairs.ended.is_empty());
+    assert!(tree.overlapping_pairs().is_empty());
+}
+
+#[test]
+fn empty_boxes_stay_out_and_queries_see_only_proxies() {
+    // 1001 bodies in AoSoA blocks: the last block's padding lanes hold the empty box, and
+    // so does body 5 (no geometry). Neither enters the tree.
+    let mut boxes: Vec<Aabb3> = (0..1001)
+        .map(|i| {
+            let c = Vec3A::new(i as f32 * 2.0, 0.0, 0.0);
+            Aabb3::new(c - 0.5, c + 0.5)
+        })
+        .collect();
+    boxes[5] = Aabb3::EMPTY;
+    let blocks = Aabb3x8::pack(&boxes);
+    assert_eq!(blocks.len() * 8, 1008);
+    let tree = DynamicTree::from_boxes(&blocks[..]).unwrap();
+    assert_eq!(tree.len(), 1000);
+    assert!(!tree.contains(5) && !tree.contains(1001) && tree.contains(1000));
+    // A query reaching everything, infinite faces included, finds exactly the proxies.
+    let everything = Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+    let mut hits = vec![];
+    tree.query(&everything, |id| hits.push(id));
+    hits.sort();
+    let expected: Vec<u32> = (0..1001).filter(|&i| i != 5).collect();
+    assert_eq!(hits, expected);
+    let mut none = vec![];
+    DynamicTree::new().query(&everything, |id| none.push(id));
+    assert!(none.is_empty());
 }
 
 #[test]
@@ -229,19 +260,25 @@ fn bad_boxes_are_refused_at_insert() {
             Err(BroadphaseError::InvalidBox { id: 1 })
         );
         assert!(!tree.contains(1));
-        assert_eq!(
-            DynamicTree::from_boxes(&[good, bad][..]).err(),
-            Some(BroadphaseError::InvalidBox { id: 1 })
-        );
+        // `from_boxes` leaves the empty box out (the padding of AoSoA blocks), and refuses
+        // the others.
+        let built = DynamicTree::from_boxes(&[good, bad][..]);
+        if bad == Aabb3::EMPTY {
+            assert!(built.is_ok_and(|t| t.len() == 1 && !t.contains(1)));
+        } else {
+            assert_eq!(built.err(), Some(BroadphaseError::InvalidBox { id: 1 }));
+        }
     }
     assert_eq!(
         tree.insert(0, good),
         Err(BroadphaseError::Duplicate { id: 0 })
     );
-    assert_eq!(
-        tree.insert(u32::MAX, good),
-        Err(BroadphaseError::IdTooLarge { id: u32::MAX })
-    );
+    for id in [u32::MAX, (1 << 31) - 2] {
+        assert_eq!(
+            tree.insert(id, good),
+            Err(BroadphaseError::IdTooLarge { id })
+        );
+    }
     assert_eq!(tree.len(), 1);
     // Nothing reached the tree: it still answers.
     let mut pairs = Pairs::with_ended();

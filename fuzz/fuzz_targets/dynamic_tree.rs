@@ -130,7 +130,7 @@ fuzz_target!(|data: &[u8]| {
             }
             3 | 4 => {
                 // A query with any box: the placed proxies it overlaps (none for a box
-                // with a NaN face or an inverted one).
+                // with a NaN face).
                 let q = boxed(&mut f);
                 let mut got = BTreeSet::new();
                 tree.query(&q, |id| {

@@ -2,8 +2,8 @@
 //! columns (eight `min.x`, then eight `min.y`, …), so that one query tests all eight
 //! children at once; a child is another node or a proxy (a leaf).
 //!
-//! **Containment.** A proxy's slot holds its box, and a node's slot in its parent holds the
-//! exact union of the node's slots: boxes are combined with `min` and `max` only, which
+//! **Containment.** A proxy's slot holds its box, and a node's slot in its parent contains
+//! the union of the node's slots: boxes are combined with `min` and `max` only, which
 //! round nothing. A new box enlarges the slots above it up to the first that already
 //! contains it ([`Hierarchy::set`], Box2D's early exit), and a remove recomputes the unions
 //! above it while they change. So a query visits every proxy whose box it overlaps. A build
@@ -351,6 +351,10 @@ impl Hierarchy {
                 let k = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
                 let c = node.child[k];
+                if c == NONE {
+                    // An empty slot (+∞ below −∞) meets only a query reaching both.
+                    continue;
+                }
                 if c & LEAF != 0 {
                     hit(c & !LEAF, &node.get(k));
                 } else {

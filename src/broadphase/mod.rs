@@ -42,10 +42,14 @@
 //! # Ok::<(), Box<dyn core::error::Error>>(())
 //! ```
 //!
-//! **What a frame reports.** Between two updates, a pair's overlap *begins* when the two fat
-//! boxes overlap now (closed boxes: touching counts) and did not at the last report, and
-//! *ends* the other way round; a body inserted, removed or parked since counts as having
-//! had, or having, no box. This is exact: the tree loses no pair and invents none, whatever
+//! **What a frame reports.** A report compares two snapshots: the pairs whose fat boxes
+//! overlap now (closed boxes: touching counts) and those that overlapped at the last
+//! report. A pair *begins* when it is in the first and not the second, and *ends* the other
+//! way round; a proxy absent or parked at either moment has no box then. What happens in
+//! between and is undone by the report is not seen: a remove and an insert of the same id
+//! between two reports, with overlapping boxes, report nothing (an engine that reuses a
+//! destroyed body's index for a new one in the same frame ends the old body's pairs
+//! itself, or reports in between). This is exact: the tree loses no pair and invents none, whatever
 //! moved, because a node's box always contains its children's (`min`/`max` round nothing)
 //! and each pair's verdict compares the two boxes themselves; the tests and a fuzz target
 //! check every report against all pairs by brute force.
@@ -133,7 +137,8 @@ pub struct Pairs {
     /// when made by [`Pairs::with_ended`]).
     pub ended: Vec<(u32, u32)>,
     /// Moved proxies whose new box was refused (NaN, infinite or inverted) since the last
-    /// report, now parked.
+    /// report, once per refusal; each was parked then (a later good box or a remove may
+    /// have changed that since).
     pub refused: Vec<u32>,
     ended_wanted: bool,
 }
@@ -145,7 +150,8 @@ impl Pairs {
         Self::default()
     }
 
-    /// Begun and ended pairs (the ended ones cost a second query per moved proxy).
+    /// Begun and ended pairs (the ended ones cost a second query per changed proxy and a
+    /// sweep along x over the changed proxies' old boxes).
     #[must_use]
     pub fn with_ended() -> Self {
         Self {
@@ -257,11 +263,13 @@ impl DynamicTree {
     }
 
     /// A tree whose proxy `i` has box `i` of `fat`, built balanced (as
-    /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first report.
+    /// [`DynamicTree::rebuild`]); every pair that overlaps begins at the first report. A box
+    /// equal to [`Aabb3::EMPTY`] (as in the padding lanes of the last AoSoA block, or for a
+    /// body with no geometry) leaves its id out of the tree.
     ///
     /// # Errors
-    /// [`BroadphaseError::InvalidBox`] for the first NaN, infinite or inverted box,
-    /// [`BroadphaseError::IdTooLarge`] for `2^31 − 2` boxes or more, and
+    /// [`BroadphaseError::InvalidBox`] for the first other NaN, infinite or inverted box,
+    /// [`BroadphaseError::IdTooLarge`] for more than `2^31 − 2` boxes, and
     /// [`BroadphaseError::Layout`] for inconsistent columns.
     pub fn from_boxes(fat: impl BoxSource<3>) -> Result<Self, BroadphaseError> {
         let len = fat.len().map_err(|_| BroadphaseError::Layout)?;
@@ -272,18 +280,26 @@ impl DynamicTree {
         for i in 0..len {
             let (min, max) = fat.get(i);
             let b = Aabb3::new(min.into(), max.into());
+            if b == Aabb3::EMPTY {
+                continue;
+            }
             if !accepts(&b) {
                 return Err(BroadphaseError::InvalidBox { id: i as u32 });
             }
             items.push((i as u32, b));
         }
+        let mut mark = alloc::vec![0; len];
+        for (k, (id, _)) in items.iter().enumerate() {
+            mark[*id as usize] = k as u32 + 1;
+        }
         let mut tree = Self {
             at: alloc::vec![ABSENT; len],
-            mark: (1..=len as u32).collect(),
-            pending: (0..len as u32)
-                .map(|id| Change::new(id, &Aabb3::EMPTY))
+            mark,
+            pending: items
+                .iter()
+                .map(|(id, _)| Change::new(*id, &Aabb3::EMPTY))
                 .collect(),
-            len,
+            len: items.len(),
             ..Self::default()
         };
         let (h, mut places) = tree.parts();
@@ -373,7 +389,9 @@ impl DynamicTree {
         self.moves += 1;
     }
 
-    /// Adds proxy `id` with fat box `fat`; its pairs begin at the next report.
+    /// Adds proxy `id` with fat box `fat`; its pairs begin at the next report (if it still
+    /// has a box then: see the module docs on what a report compares). The tree's memory
+    /// grows with the largest id (8 bytes per id up to it).
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
@@ -393,8 +411,8 @@ impl DynamicTree {
         Ok(())
     }
 
-    /// Removes proxy `id`; its pairs end at the next report. Returns false when it was not
-    /// in the tree.
+    /// Removes proxy `id`; its pairs end at the next report (unless it is back with an
+    /// overlapping box by then). Returns false when it was not in the tree.
     pub fn remove(&mut self, id: u32) -> bool {
         if !self.contains(id) {
             return false;
@@ -439,7 +457,8 @@ impl DynamicTree {
         out
     }
 
-    /// One frame: [`DynamicTree::write`] then [`DynamicTree::report`].
+    /// One frame: [`DynamicTree::write`], [`DynamicTree::maintain`], then
+    /// [`DynamicTree::report`].
     ///
     /// # Errors
     /// As [`DynamicTree::write`], before anything changes.
