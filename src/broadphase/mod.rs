@@ -92,7 +92,7 @@ pub enum BroadphaseError {
         /// The id.
         id: u32,
     },
-    /// The moved list of [`DynamicTree::update`] is not strictly ascending.
+    /// The moved list of [`DynamicTree::write`] (or `update`) is not strictly ascending.
     Unsorted,
     /// A moved id past the end of the fat boxes.
     MissingBox {
@@ -170,7 +170,8 @@ impl Pairs {
 /// Where a proxy is: nowhere, parked, or a slot.
 const ABSENT: u32 = u32::MAX;
 const PARKED: u32 = u32::MAX - 1;
-/// Ids are packed in 31 bits, with the two codes above kept out of range.
+/// Ids stay below `2^31 − 2`: a child reference packs a proxy id in 31 bits beside the
+/// leaf bit, where `2^31 − 1` would read as an empty child.
 const MAX_ID: u32 = (1 << 31) - 2;
 
 /// A proxy whose box changed since the last report, and its box then (the empty box when
