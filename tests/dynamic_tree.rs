@@ -84,9 +84,11 @@ fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
         .update(margin, Active::All, &local, &poses, &mut fat, &mut moved)
         .unwrap();
     let mut tree = DynamicTree::from_boxes(&fat).unwrap();
-    // Rebuilt by its upkeep every few frames (two moves per proxy), besides the explicit
-    // rebuilds below.
+    // Rebuilt by its upkeep every few frames (two moves per proxy, each rebuild spread over
+    // three frames, so that moves, removes and inserts meet rebuilds under way), besides
+    // the explicit rebuilds below.
     tree.set_rebuild_after(2.0);
+    tree.set_rebuild_frames(3);
     let mut maintained = 0;
     let mut member = vec![true; N];
     let mut awake = vec![true; N];
@@ -167,6 +169,70 @@ fn every_frame_reports_exactly_the_pairs_that_began_and_ended() {
     );
     assert!(before.len() > 300, "{} pairs at the end", before.len());
     assert!(maintained > 10, "{maintained} rebuilds by the upkeep");
+}
+
+#[test]
+fn a_rebuild_spread_over_frames_misses_no_change_made_meanwhile() {
+    // A rebuild under way, spread over many frames, while proxies move, leave, come back,
+    // are parked by a bad box and unparked: every frame's pairs and boxes are exact, and
+    // the rebuilds finish.
+    const N: usize = 300;
+    let mut r = StdRng::seed_from_u64(47);
+    let random_box = |r: &mut StdRng| {
+        let c = Vec3A::new(
+            r.random_range(-5.0..5.0),
+            r.random_range(-5.0..5.0),
+            r.random_range(-5.0..5.0),
+        );
+        let e = Vec3A::splat(r.random_range(0.2..0.8));
+        Aabb3::new(c - e, c + e)
+    };
+    let mut fat: Vec<Aabb3> = (0..N).map(|_| random_box(&mut r)).collect();
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    tree.set_rebuild_after(0.5);
+    tree.set_rebuild_frames(6);
+    let mut member = vec![true; N];
+    let mut parked = vec![false; N];
+    let mut pairs = Pairs::with_ended();
+    let mut before = Set::new();
+    let (mut finished, mut refused) = (0, 0);
+    for frame in 0..200 {
+        for _ in 0..4 {
+            let i = r.random_range(0..N);
+            if member[i] {
+                assert!(tree.remove(i as u32));
+            } else {
+                fat[i] = random_box(&mut r);
+                tree.insert(i as u32, fat[i]).unwrap();
+                parked[i] = false;
+            }
+            member[i] = !member[i];
+        }
+        let mut moved = Vec::new();
+        for i in 0..N {
+            if r.random_bool(0.2) {
+                moved.push(i as u32);
+                let bad = r.random_bool(0.03);
+                fat[i] = if bad { Aabb3::NAN } else { random_box(&mut r) };
+                parked[i] = member[i] && bad;
+            }
+        }
+        tree.write(&moved, &fat).unwrap();
+        finished += usize::from(tree.maintain());
+        tree.report(&mut pairs);
+        refused += pairs.refused.len();
+        let placed: Vec<bool> = (0..N).map(|i| member[i] && !parked[i]).collect();
+        let now = brute_force(&fat, &placed);
+        check(frame, &pairs, &before, &now, &tree);
+        for i in 0..N {
+            assert_eq!(tree.contains(i as u32), member[i], "frame {frame}");
+            assert_eq!(tree.is_parked(i as u32), member[i] && parked[i]);
+            assert_eq!(tree.get(i as u32), placed[i].then_some(fat[i]));
+        }
+        before = now;
+    }
+    assert!(finished > 10, "{finished} rebuilds finished");
+    assert!(refused > 50, "{refused} boxes refused");
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! The broadphase's dynamic tree against a brute-force reference, over any sequence of
-//! inserts, removes, moves (`write`), reports, queries, rebuilds and upkeep (`maintain`),
+//! inserts, removes, moves (`write`), reports, queries, rebuilds and upkeep (`maintain`, its
+//! rebuilds spread over several calls),
 //! with any boxes: small integer boxes that overlap often, and faces of any bits (NaN, ±∞, ±MAX,
 //! subnormals). After every operation the tree holds what the reference holds (placed,
 //! parked or absent, and each box bit for bit); every query finds the placed boxes it
@@ -142,11 +143,14 @@ fuzz_target!(|data: &[u8]| {
                 assert_eq!(got, expected, "query {q:?}");
             }
             5 => {
-                if f.byte() % 2 == 0 {
+                let b = f.byte();
+                if b % 2 == 0 {
                     tree.rebuild();
                 } else {
-                    // The upkeep, rebuilding any hierarchy that took a move since its build.
+                    // The upkeep: a rebuild once anything moved since the last build, spread
+                    // over up to eight calls, so that other operations meet it under way.
                     tree.set_rebuild_after(0.0);
+                    tree.set_rebuild_frames(u32::from(b / 2 % 8) + 1);
                     tree.maintain();
                 }
             }

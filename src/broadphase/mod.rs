@@ -7,7 +7,8 @@
 //! [`DynamicTree::update`] runs the frame's three steps (each also callable alone):
 //! [`write`](DynamicTree::write) rewrites the moved proxies' boxes, enlarging the nodes
 //! above each up to the first that already holds it; [`maintain`](DynamicTree::maintain)
-//! rebuilds a hierarchy once enough has moved since its last build;
+//! builds a new hierarchy once enough has moved since the last build, a share in each
+//! call, and swaps it in when done;
 //! [`report`](DynamicTree::report) searches pairs only from the proxies changed since the
 //! last report:
 //!
@@ -234,6 +235,16 @@ pub struct DynamicTree {
     moves: u64,
     /// [`DynamicTree::set_rebuild_after`].
     rebuild_after: f32,
+    /// The hierarchy a rebuild fills, and the proxies' slots in it; kept between rebuilds
+    /// for their memory.
+    spare: Hierarchy,
+    spare_at: Vec<u32>,
+    /// The budget of each step of the rebuild under way, if one is.
+    rebuilding: Option<usize>,
+    /// The proxies inserted, removed, parked or unparked since the rebuild under way began.
+    replay: Vec<u32>,
+    /// [`DynamicTree::set_rebuild_frames`].
+    rebuild_frames: u32,
     /// Scratch: the order of the changes, the query stack.
     order: Vec<u64>,
     stack: Vec<u32>,
@@ -250,6 +261,11 @@ impl Default for DynamicTree {
             len: 0,
             moves: 0,
             rebuild_after: 16.0,
+            spare: Hierarchy::default(),
+            spare_at: Vec::new(),
+            rebuilding: None,
+            replay: Vec::new(),
+            rebuild_frames: 32,
             order: Vec::new(),
             stack: Vec::new(),
         }
@@ -303,8 +319,16 @@ impl DynamicTree {
             len: items.len(),
             ..Self::default()
         };
-        let (h, mut places) = tree.parts();
-        h.build(items, &mut places);
+        tree.hierarchy.begin(items);
+        let mut places = Placer { at: &mut tree.at };
+        tree.hierarchy.step(
+            usize::MAX,
+            |id| {
+                let (min, max) = fat.get(id as usize);
+                Some(Aabb3::new(min.into(), max.into()))
+            },
+            &mut places,
+        );
         Ok(tree)
     }
 
@@ -407,6 +431,7 @@ impl DynamicTree {
             return Err(BroadphaseError::Duplicate { id });
         }
         self.note(id);
+        self.restructured(id);
         self.place(id, &fat);
         self.len += 1;
         Ok(())
@@ -419,6 +444,7 @@ impl DynamicTree {
             return false;
         }
         self.note(id);
+        self.restructured(id);
         if !self.is_parked(id) {
             self.take_out(id);
         }
@@ -431,9 +457,82 @@ impl DynamicTree {
     /// centres). Boxes and pairs do not change; queries get faster where moves have left
     /// node boxes loose or mixed distant proxies under one node.
     pub fn rebuild(&mut self) {
-        let (h, mut places) = self.parts();
-        h.rebuild(&mut places);
+        self.begin_rebuild(usize::MAX);
+        self.continue_rebuild();
+    }
+
+    /// Starts a rebuild into the spare hierarchy from the proxies as they are, to advance by
+    /// `budget` units of work per [`DynamicTree::continue_rebuild`]. A rebuild under way is
+    /// dropped.
+    fn begin_rebuild(&mut self, budget: usize) {
+        self.spare.begin_from(&self.hierarchy);
+        // Placed proxies are absent until the build places them; absent and parked ones
+        // stay so.
+        self.spare_at.clear();
+        self.spare_at.extend(
+            self.at
+                .iter()
+                .map(|&at| if at == PARKED { PARKED } else { ABSENT }),
+        );
+        self.replay.clear();
+        self.rebuilding = Some(budget);
         self.moves = 0;
+    }
+
+    /// Advances the rebuild under way by its budget; once its build is done, brings the
+    /// proxies inserted, removed, parked or unparked meanwhile up to date in it and makes it
+    /// the tree. Returns true then.
+    fn continue_rebuild(&mut self) -> bool {
+        let Some(budget) = self.rebuilding else {
+            return false;
+        };
+        let (hierarchy, at) = (&self.hierarchy, &self.at);
+        let mut places = Placer {
+            at: &mut self.spare_at,
+        };
+        // A proxy is placed with the box it has now, if it is still placed; a later write
+        // goes to both hierarchies (`DynamicTree::set`).
+        let box_of = |id: u32| match at[id as usize] {
+            ABSENT | PARKED => None,
+            slot => Some(hierarchy.get(Slot(slot))),
+        };
+        if !self.spare.step(budget, box_of, &mut places) {
+            return false;
+        }
+        let replay = take(&mut self.replay);
+        self.spare_at.resize(self.at.len(), ABSENT);
+        for &id in &replay {
+            let (now, then) = (self.at[id as usize], self.spare_at[id as usize]);
+            let placed = |at: u32| at != ABSENT && at != PARKED;
+            let mut places = Placer {
+                at: &mut self.spare_at,
+            };
+            match (placed(now), placed(then)) {
+                (true, true) => self.spare.set(Slot(then), &self.hierarchy.get(Slot(now))),
+                (true, false) => {
+                    let b = self.hierarchy.get(Slot(now));
+                    self.spare.insert(id, &b, &mut places);
+                }
+                (false, true) => {
+                    self.spare.remove(Slot(then));
+                    places.at[id as usize] = now;
+                }
+                (false, false) => places.at[id as usize] = now,
+            }
+        }
+        core::mem::swap(&mut self.hierarchy, &mut self.spare);
+        core::mem::swap(&mut self.at, &mut self.spare_at);
+        self.replay = replay;
+        self.rebuilding = None;
+        true
+    }
+
+    /// Notes that proxy `id` is inserted, removed, parked or unparked, for the rebuild under
+    /// way (which brings such proxies up to date when its build is done).
+    fn restructured(&mut self, id: u32) {
+        if self.rebuilding.is_some() {
+            self.replay.push(id);
+        }
     }
 
     /// Calls `hit(id)` for every placed proxy whose fat box overlaps `b` (closed boxes).
@@ -475,25 +574,40 @@ impl DynamicTree {
         Ok(())
     }
 
-    /// Sets when [`DynamicTree::maintain`] rebuilds the tree: once it has taken this many
-    /// moves and inserts per proxy since its last build (default 16; `f32::INFINITY`
+    /// Sets when [`DynamicTree::maintain`] starts a rebuild: once the tree has taken this
+    /// many moves and inserts per proxy since its last build (default 16; `f32::INFINITY`
     /// never, leaving [`DynamicTree::rebuild`] to the caller).
     pub fn set_rebuild_after(&mut self, moves_per_proxy: f32) {
         self.rebuild_after = moves_per_proxy;
     }
 
-    /// The tree's upkeep, between [`DynamicTree::write`] and [`DynamicTree::report`]: moves
-    /// leave node boxes loose and mix distant proxies under one node, so the tree is rebuilt
-    /// once it has taken enough moves since its last build (see
-    /// [`DynamicTree::set_rebuild_after`]). Returns whether it was. Boxes and pairs do not
-    /// change.
+    /// Sets over how many [`DynamicTree::maintain`] calls a rebuild is spread (default 32;
+    /// 1 rebuilds at once). Fewer frames give each a larger share of the work; more leave
+    /// the old hierarchy in use longer.
+    pub fn set_rebuild_frames(&mut self, frames: u32) {
+        self.rebuild_frames = frames.max(1);
+    }
+
+    /// The tree's upkeep, between [`DynamicTree::write`] and [`DynamicTree::report`].
+    ///
+    /// Moves leave node boxes loose and mix distant proxies under one node, so once the
+    /// tree has taken enough moves since its last build ([`DynamicTree::set_rebuild_after`])
+    /// a new hierarchy is built beside it, a share of the work in each call
+    /// ([`DynamicTree::set_rebuild_frames`]), while the old one serves the frames: no frame
+    /// pays for a whole rebuild. Until the new hierarchy takes over, each write goes to
+    /// both, and proxies inserted or removed meanwhile are brought up to date in it when its
+    /// build is done. Returns true when a new hierarchy took over. Boxes and pairs do not
+    /// change; the rebuild needs a second hierarchy's memory (about 37 bytes per proxy).
     pub fn maintain(&mut self) -> bool {
-        let proxies = self.len.max(1) as f32;
-        let rebuild = self.moves as f32 > self.rebuild_after * proxies;
-        if rebuild {
-            self.rebuild();
+        if self.rebuilding.is_none() {
+            let proxies = self.len.max(1) as f32;
+            if self.moves as f32 <= self.rebuild_after * proxies {
+                return false;
+            }
+            let work = Hierarchy::build_work(self.len);
+            self.begin_rebuild(work.div_ceil(self.rebuild_frames as usize).max(1));
         }
-        rebuild
+        self.continue_rebuild()
     }
 
     /// The tree's half of a frame: the proxies in `moved` (strictly ascending ids, as
@@ -546,6 +660,14 @@ impl DynamicTree {
                 self.hierarchy.prefetch_parent(Slot(at));
             } else {
                 self.hierarchy.prefetch(Slot(at));
+                // A rebuild under way takes the write too.
+                if self.rebuilding.is_some()
+                    && let Some(&then) = self.spare_at.get(id as usize)
+                    && then != ABSENT
+                    && then != PARKED
+                {
+                    self.spare.prefetch(Slot(then));
+                }
             }
         }
     }
@@ -556,14 +678,23 @@ impl DynamicTree {
         let at = self.at[id as usize];
         if accepts(b) {
             if at == PARKED {
+                self.restructured(id);
                 self.place(id, b);
             } else {
                 self.hierarchy.set(Slot(at), b);
                 self.moves += 1;
+                if self.rebuilding.is_some()
+                    && let Some(&then) = self.spare_at.get(id as usize)
+                    && then != ABSENT
+                    && then != PARKED
+                {
+                    self.spare.set_during_build(Slot(then), b);
+                }
             }
         } else {
             self.refused.push(id);
             if at != PARKED {
+                self.restructured(id);
                 self.take_out(id);
                 self.at[id as usize] = PARKED;
             }

@@ -472,6 +472,8 @@ pub fn run(
     // Over the checked frames: overlapping world boxes, and leaf pairs of one tree only.
     let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
     let (mut missing, mut wrong) = (0, 0);
+    // C's slowest upkeep and slowest frame.
+    let (mut slowest_upkeep, mut slowest_frame) = (0.0f64, 0.0f64);
     for frame in 0..frames {
         scene.step();
         let f = pipelines.frame(&scene);
@@ -495,6 +497,8 @@ pub fn run(
             only_b += all_b.difference(&all_a).count();
         }
         print_frame(&frame.to_string(), &f);
+        slowest_upkeep = slowest_upkeep.max(f[2].ms[2]);
+        slowest_frame = slowest_frame.max(f[2].total());
         for (total, f) in sum.iter_mut().zip(&f) {
             for k in 0..5 {
                 total.ms[k] += f.ms[k];
@@ -530,6 +534,11 @@ pub fn run(
             only_b as f64 / f
         );
     }
+    println!(
+        "C's slowest frame {slowest_frame:.1} ms; its upkeep (maintain) {:.2} ms per frame on \
+         average, {slowest_upkeep:.1} ms in the slowest",
+        mean[2].ms[2]
+    );
     if check {
         println!(
             "C's begun pairs against a sweep over its fat boxes, every frame: {missing} \
