@@ -97,11 +97,20 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 /// and costs at most `2^-150` below it. With `|c_j| + e_j = max(|lo_j|, |hi_j|)` the face
 /// error is at most `γ(N+3)·S + TINY_ERROR`.
 ///
-/// The pad reuses what the method has: `2S' = |2t| + 2^-79 + |M|·(|2c| + 2e)` is `N` more
-/// multiply-adds on the `|M|` of `2e'`, applied to `2c' ∓ 2e'` before the halving.
-/// The computed `|2c| + 2e` is at least `(1 − u)²·2·max(|lo|, |hi|)` and the dot product of
-/// positive terms loses at most `γ(N + 1)`, so the computed `2S'` is at least
-/// `2S'·(1 − γ(N + 3))`; the argument of [`outward_pad`] then applies with doubled terms.
+/// The pad reuses what the method has, `2S' = |2t| + 2^-79 + |M|·(|2c| + 2e)`, applied to
+/// `2c' ∓ 2e'` before the halving:
+/// - where the lanes fuse, `N` more multiply-adds on the `|M|` of `2e'`. The computed
+///   `|2c| + 2e` is at least `(1 − u)²·2·max(|lo|, |hi|)` and the dot product of positive
+///   terms loses at most `γ(N + 1)`;
+/// - unfused, `|M|·|2c|` is the sum of the centre's own rounded products `|m_ij·2c_j|`
+///   (the absolute value of a rounded product is the rounded product of the absolute
+///   values), and `|M|·2e` is `2e'` itself: `(|2t| + 2^-79) + Σ_j |m_ij·2c_j| + 2e'_i`,
+///   `N + 2` additions and no multiplication. A term `|m_ij·2c_j|` rounds twice (`2c`,
+///   the product) and meets `N + 1` additions; a term of `2e'` rounds twice and meets at
+///   most `N` (`N − 1` inside `2e'`, then one);
+///
+/// so either way the computed `2S'` is at least `2S'·(1 − γ(N + 3))`, and the argument of
+/// [`outward_pad`] then applies with doubled terms.
 /// The doubled pad is at least `2^-79·k·u >= 2^-101` (`k >= 7`), so on normal-range input
 /// `2c' ∓ 2e' ∓ pad` is a multiple of `2^-125` and its half a multiple of `2^-126`: zero
 /// or normal (see [`outward_pad`]).
@@ -115,18 +124,34 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     let center2 = lo + hi;
     let extent2 = hi - lo;
     let t2 = a.t + a.t;
-    let mut world_center2 = a.cols[0].mul_add(center2.axis(0), t2);
+    let mut world_center2 = t2;
+    // Unfused, the centre's products, which the pad reuses.
+    let mut products = [t2; N];
     let mut world_extent2 = a.cols[0].abs() * extent2.axis(0);
-    for j in 1..N {
-        world_center2 = a.cols[j].mul_add(center2.axis(j), world_center2);
-        world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
+    for (j, product) in products.iter_mut().enumerate() {
+        if V::FUSES {
+            world_center2 = a.cols[j].mul_add(center2.axis(j), world_center2);
+        } else {
+            *product = a.cols[j] * center2.axis(j);
+            world_center2 = *product + world_center2;
+        }
+        if j > 0 {
+            world_extent2 = a.cols[j].abs().mul_add(extent2.axis(j), world_extent2);
+        }
     }
     let (mut min2, mut max2) = (world_center2 - world_extent2, world_center2 + world_extent2);
     if let Some(k) = pad_factor {
-        let reach2 = center2.abs() + extent2;
         let mut magnitude2 = t2.abs() + V::splat(2.0 * REACH_FLOOR);
-        for j in 0..N {
-            magnitude2 = a.cols[j].abs().mul_add(reach2.axis(j), magnitude2);
+        if V::FUSES {
+            let reach2 = center2.abs() + extent2;
+            for j in 0..N {
+                magnitude2 = a.cols[j].abs().mul_add(reach2.axis(j), magnitude2);
+            }
+        } else {
+            for p in products {
+                magnitude2 = magnitude2 + p.abs();
+            }
+            magnitude2 = magnitude2 + world_extent2;
         }
         let pad2 = magnitude2 * V::splat(k as f32 * UNIT_ROUNDOFF);
         (min2, max2) = (min2 - pad2, max2 + pad2);
