@@ -84,3 +84,19 @@ for m in ["abs-matrix", "sign-select"]:
     target(f"AoS rigid {m}: Nearest ≥ 1.3× faster than the glam rigid loop", [(c, f"aos-rigid/{m}/nearest", "peer/glam-rigid-abs-matrix") for c in cache], 1.3, True)
     target(f"AoS rigid {m}: Outward no slower than the glam rigid loop", [(c, f"aos-rigid/{m}/outward", "peer/glam-rigid-abs-matrix") for c in cache], 1.0, True)
 target("AoSoA translation Outward ≤ 1.5× the glam translation loop", [(c, "aosoa-translation/outward", "peer/glam-translation") for c in cache], 1.5)
+
+# The targets of the front-door issue (45): at 1K boxes in cache, and the AoS rows at 4M
+# against the AoS copy roofline.
+print()
+print("| front-door target (issue 45) | measured | |")
+print("|---|---|---|")
+target("AoS affine abs-matrix: Nearest ≤ 0.77× the glam loop", [("1K", "aos/abs-matrix/nearest", "peer/glam-abs-matrix")], 0.77)
+for m in ["abs-matrix", "sign-select"]:
+    target(f"AoS affine {m}: Outward ≤ 1.0× the glam loop", [("1K", f"aos/{m}/outward", "peer/glam-abs-matrix")], 1.0)
+target("AoS rigid abs-matrix: Nearest ≤ 0.7× the glam rigid loop", [("1K", "aos-rigid/abs-matrix/nearest", "peer/glam-rigid-abs-matrix")], 0.7)
+target("AoS translation: Outward ≤ 1.3× the glam translation loop", [("1K", "aos-translation/outward", "peer/glam-translation")], 1.3)
+target("one box affine abs-matrix: Nearest ≤ 1.3× the glam loop", [("1K", "single/abs-matrix/nearest", "peer/glam-abs-matrix")], 1.3)
+target("one box affine abs-matrix: Outward ≤ 1.5× the glam loop", [("1K", "single/abs-matrix/outward", "peer/glam-abs-matrix")], 1.5)
+for m in ["abs-matrix", "sign-select"]:
+    for r in ["nearest", "outward"]:
+        target(f"AoS affine {m} {r} at 4M: ≤ 1.15× the AoS roofline", [("4M", f"aos/{m}/{r}", "roofline/aos")], 1.15)
