@@ -1,8 +1,10 @@
-//! One `Batch::transform` and one `Batch::update` call on AoS slices of `Rigid3`.
+//! One `Batch::transform` and one `Batch::update` call on AoS slices of `Rigid3`, and the
+//! broadphase tree fed by the update (the README's call sequence).
+use bvkit::broadphase::{DynamicTree, Pairs};
 use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
 use glam::{Quat, Vec3, Vec3A};
 
-fn main() -> Result<(), bvkit::BatchError> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let local = vec![Aabb3::new(Vec3A::splat(-0.5), Vec3A::splat(0.5)); 1000];
     let mut poses: Vec<Rigid3> = (0..1000)
         .map(|i| (Quat::IDENTITY, Vec3::X * i as f32).into())
@@ -15,6 +17,9 @@ fn main() -> Result<(), bvkit::BatchError> {
     poses[7].rotation = Quat::from_rotation_z(0.8);
     let margin = Margin::new(0.05, 0.1);
     batch.update(margin, Active::All, &local, &poses, &mut fat, &mut moved)?;
-    println!("{} moved; {:?}", moved.len(), world[7]);
+    let mut tree = DynamicTree::from_boxes(&fat)?;
+    let mut pairs = Pairs::new();
+    tree.update(moved.indices(), &fat, &mut pairs)?;
+    println!("{} moved, {} pairs; {:?}", moved.len(), pairs.begun.len(), world[7]);
     Ok(())
 }
