@@ -527,6 +527,13 @@ impl DynamicTree {
         true
     }
 
+    /// Proxy `id`'s slot in the hierarchy a rebuild under way fills, once placed there.
+    #[inline(always)]
+    fn spare_slot(&self, id: u32) -> Option<Slot> {
+        let then = *self.spare_at.get(id as usize)?;
+        (self.rebuilding.is_some() && then != ABSENT && then != PARKED).then_some(Slot(then))
+    }
+
     /// Notes that proxy `id` is inserted, removed, parked or unparked, for the rebuild under
     /// way (which brings such proxies up to date when its build is done).
     fn restructured(&mut self, id: u32) {
@@ -597,7 +604,8 @@ impl DynamicTree {
     /// pays for a whole rebuild. Until the new hierarchy takes over, each write goes to
     /// both, and proxies inserted or removed meanwhile are brought up to date in it when its
     /// build is done. Returns true when a new hierarchy took over. Boxes and pairs do not
-    /// change; the rebuild needs a second hierarchy's memory (about 37 bytes per proxy).
+    /// change; the rebuild needs a second hierarchy's memory (about 57 bytes per proxy: its
+    /// nodes, the centres it sorts, the proxies' slots in it).
     pub fn maintain(&mut self) -> bool {
         if self.rebuilding.is_none() {
             let proxies = self.len.max(1) as f32;
@@ -661,12 +669,8 @@ impl DynamicTree {
             } else {
                 self.hierarchy.prefetch(Slot(at));
                 // A rebuild under way takes the write too.
-                if self.rebuilding.is_some()
-                    && let Some(&then) = self.spare_at.get(id as usize)
-                    && then != ABSENT
-                    && then != PARKED
-                {
-                    self.spare.prefetch(Slot(then));
+                if let Some(slot) = self.spare_slot(id) {
+                    self.spare.prefetch(slot);
                 }
             }
         }
@@ -683,12 +687,8 @@ impl DynamicTree {
             } else {
                 self.hierarchy.set(Slot(at), b);
                 self.moves += 1;
-                if self.rebuilding.is_some()
-                    && let Some(&then) = self.spare_at.get(id as usize)
-                    && then != ABSENT
-                    && then != PARKED
-                {
-                    self.spare.set_during_build(Slot(then), b);
+                if let Some(slot) = self.spare_slot(id) {
+                    self.spare.set_during_build(slot, b);
                 }
             }
         } else {
