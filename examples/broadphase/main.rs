@@ -13,6 +13,7 @@
 //!   B on parry3d's `Bvh` (rapier's, and fed by bvkit's update; the options tune B), C on
 //!   bvkit's own `broadphase::DynamicTree`, D on obvhs's `Bvh2`. Up to 20K bodies it checks
 //!   C's begun pairs every frame against a sweep, and fails on any difference.
+//!   `--rebuild-after M` and `--rebuild-frames F` tune C's upkeep (here and in `tree`).
 //! - `cargo run --release --features peers --example broadphase tree [T]`: the four
 //!   pipelines on the two scenes of issue 47 (1M bodies half asleep, 100K all awake), T
 //!   frames each (default 100, so that the means include the tree's rebuilds at 1M), C's begun pairs checked every frame against a sweep; the
@@ -46,6 +47,8 @@ fn main() {
     let tuning = bvh::Tuning {
         relative: option("--relative").unwrap_or(0.0) as f32,
         partial: option("--partial").unwrap_or(0.0) as usize,
+        rebuild_after: option("--rebuild-after").map(|x| x as f32),
+        rebuild_frames: option("--rebuild-frames").map(|x| x as u32),
     };
     let arg = |k: usize, default: f64| {
         args.get(k)

@@ -72,6 +72,10 @@ pub struct Tuning {
     /// Optimise and refit the whole tree every this many frames, and refit only the changed
     /// paths in between (0: the whole tree every frame, as A).
     pub partial: usize,
+    /// C's `DynamicTree::set_rebuild_after`, where given.
+    pub rebuild_after: Option<f32>,
+    /// C's `DynamicTree::set_rebuild_frames`, where given.
+    pub rebuild_frames: Option<u32>,
 }
 
 /// The milliseconds of a frame's stages, and what they did.
@@ -260,6 +264,12 @@ impl Pipelines {
         let mut mask8 = scene.mask.clone();
         mask8.resize((8 * local8.len()).div_ceil(64), 0);
         let mut tree = DynamicTree::from_boxes(&fat[..]).expect("finite fat boxes");
+        if let Some(after) = tuning.rebuild_after {
+            tree.set_rebuild_after(after);
+        }
+        if let Some(frames) = tuning.rebuild_frames {
+            tree.set_rebuild_frames(frames);
+        }
         let mut pairs = Pairs::new();
         // The first report: every overlapping pair begins.
         tree.report(&mut pairs);
