@@ -991,3 +991,81 @@ fn bad_input_is_refused_and_nothing_is_written() {
     }
     assert!(fat.iter().zip(&fat0).all(|(a, b)| same3(a, b)));
 }
+
+// ---------------------------------------------------------------------------------------
+// The same pose sources through `Batch::transform`.
+
+#[test]
+fn transform_takes_swept_and_large_world_poses_as_the_update_does() {
+    // One pose trait for both verbs: a swept pair gives the union of the boxes at its two
+    // poses, bit for bit in deterministic mode (where every path gives the reference's
+    // bits); large-world poses give each pose's relative box. Every backend, method and
+    // rounding, AoS and AoSoA boxes, lengths across span and chunk edges.
+    let mut r = rng(45);
+    for n in [0, 1, 7, 17, 70] {
+        let local: Vec<Aabb3> = (0..n)
+            .map(|_| {
+                let c = Vec3A::new(r.random(), r.random(), r.random()) * 4.0 - 2.0;
+                Aabb3::new(c - 0.5, c + Vec3A::new(0.3, 0.7, 0.1))
+            })
+            .collect();
+        let pose = |r: &mut StdRng| {
+            let q = Quat::from_rotation_arc(
+                Vec3A::X.into(),
+                Vec3A::new(r.random(), 1.0, 0.5).normalize().into(),
+            );
+            Rigid3::new(q, Vec3A::new(r.random(), r.random(), r.random()) * 100.0)
+        };
+        let a: Vec<Rigid3> = (0..n).map(|_| pose(&mut r)).collect();
+        let b: Vec<Rigid3> = (0..n).map(|_| pose(&mut r)).collect();
+        let origin = DVec3::new(1e7, -3e6, 2.5e5);
+        let large: Vec<LargeRigid3> = a
+            .iter()
+            .map(|p| LargeRigid3::new(p.rotation, origin + p.translation.as_dvec3()))
+            .collect();
+        for backend in Backend::supported() {
+            for method in [Method::AbsMatrix, Method::SignSelect] {
+                for rounding in [Rounding::Nearest, Rounding::Outward] {
+                    let batch = Batch::new(method, rounding)
+                        .on(backend)
+                        .unwrap()
+                        .deterministic();
+                    let mut wa = vec![Aabb3::EMPTY; n];
+                    let mut wb = vec![Aabb3::EMPTY; n];
+                    let mut ws = vec![Aabb3::EMPTY; n];
+                    batch.transform(&local, &a, &mut wa).unwrap();
+                    batch.transform(&local, &b, &mut wb).unwrap();
+                    let swept = Swept {
+                        current: &a[..],
+                        predicted: &b[..],
+                    };
+                    batch.transform(&local, swept, &mut ws).unwrap();
+                    let (a8, b8) = (bvkit::Rigid3x8::pack(&a), bvkit::Rigid3x8::pack(&b));
+                    let swept8 = Swept {
+                        current: &a8[..],
+                        predicted: &b8[..],
+                    };
+                    let mut w8 = vec![bvkit::Aabb3x8::default(); n.div_ceil(8)];
+                    batch
+                        .transform(&bvkit::Aabb3x8::pack(&local)[..], swept8, &mut w8[..])
+                        .unwrap();
+                    for k in 0..n {
+                        let union = Aabb3::new(wa[k].min.min(wb[k].min), wa[k].max.max(wb[k].max));
+                        assert_eq!(ws[k], union, "{backend:?} {method:?} {rounding:?} {k}");
+                        assert_eq!(w8[k / 8].get(k % 8), union);
+                    }
+                    let world = LargeWorld {
+                        poses: &large[..],
+                        origin,
+                    };
+                    let mut wl = vec![Aabb3::EMPTY; n];
+                    batch.transform(&local, world, &mut wl).unwrap();
+                    for k in 0..n {
+                        assert_eq!(wl[k], large[k].relative_aabb(&local[k], origin, method));
+                        assert!(wl[k].contains_point(wa[k].min * 0.5 + wa[k].max * 0.5));
+                    }
+                }
+            }
+        }
+    }
+}

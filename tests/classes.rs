@@ -568,7 +568,7 @@ fn bad_lengths_are_refused_and_leave_the_output_untouched() {
         assert_eq!(
             batch.transform(&local, &xfs, &mut out),
             Err(BatchError::LengthMismatch {
-                what: "transforms",
+                what: "poses",
                 expected: 10,
                 found: 9
             })

@@ -1,5 +1,6 @@
 //! `Batch::transform_par` (feature `rayon`) against `Batch::transform`: bit-identical on
-//! every supported backend, in both modes, for every layout, method and rounding, with
+//! every supported backend, in both modes, for every layout (and a swept pair of poses),
+//! method and rounding, with
 //! extreme inputs mixed in and lengths that leave short last parts and lane tails.
 #![cfg(feature = "rayon")]
 
@@ -62,6 +63,18 @@ where
                 batch.transform(local, &xfs[0], &mut serial).unwrap();
                 batch.transform_par(local, &xfs[0], &mut parallel).unwrap();
                 assert_eq!(bits(&serial), bits(&parallel), "AoS shared {name}");
+
+                // A swept pair of poses (the update's pose sources work here too).
+                let swept = bvkit::Swept {
+                    current: xfs,
+                    predicted: &xfs[0],
+                };
+                let (mut serial, mut parallel) = (vec![Aabb3::NAN; n], vec![Aabb3::EMPTY; n]);
+                batch.transform(local, swept, &mut serial[..]).unwrap();
+                batch
+                    .transform_par(local, swept, &mut parallel[..])
+                    .unwrap();
+                assert_eq!(bits(&serial), bits(&parallel), "AoS swept {name}");
 
                 let mut serial = vec![Aabb3x8::default(); lb.len()];
                 let mut parallel = vec![Aabb3x8::default(); lb.len()];

@@ -12,7 +12,7 @@ mod update;
 
 pub use large::{LargePose, LargeRigid3};
 pub use moved::Moved;
-pub use update::{LargeWorld, PoseSource, Swept};
+pub use update::{LargeWorld, Swept};
 
 use core::marker::PhantomData;
 
@@ -21,10 +21,16 @@ use crate::aabb::Aabb3;
 use crate::engine::Poses;
 use crate::error::BatchError;
 #[cfg(doc)]
-use crate::layout::{BoxSink, BoxSource, TransformSource};
-use crate::layout::{ReadBoxes, ReadMaps, WriteBoxes};
+use crate::layout::{BoxSink, BoxSource};
+use crate::layout::{ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
+
+/// The poses a batch reads, for [`Batch::transform`] and [`Batch::update`] alike: transforms
+/// of any class in any layout (AoS slices `&[T]`, AoSoA blocks, SoA columns, or one shared
+/// `&T`), a [`Swept`] pair of them, or [`LargeWorld`] poses. Sealed.
+pub trait PoseSource<const N: usize>: Poses<N> {}
+impl<const N: usize, P: Poses<N>> PoseSource<N> for P {}
 
 /// How a batch runs: the method, the rounding and the backend.
 ///
@@ -32,7 +38,7 @@ use crate::simd::Backend;
 ///
 /// Many boxes at once, in any layout, through any transform class, on the best backend.
 ///
-/// One entry point, [`Batch::transform`], takes a [`BoxSource`], a [`TransformSource`] and
+/// One entry point, [`Batch::transform`], takes a [`BoxSource`], a [`PoseSource`] and
 /// a [`BoxSink`]:
 ///
 /// | layout | boxes read | boxes written | transforms read |
@@ -138,13 +144,11 @@ impl<const N: usize, B: ReadBoxes<N>, X: Poses<N>, O: WriteBoxes<N>> AosLayouts<
 
 fn checked_len<const N: usize>(
     local: &impl ReadBoxes<N>,
-    xf: &impl ReadMaps<N>,
+    poses: &impl Poses<N>,
     out: &mut impl WriteBoxes<N>,
 ) -> Result<usize, BatchError> {
     let len = local.len()?;
-    if let Some(n) = xf.len()? {
-        BatchError::check_len("transforms", len, n)?;
-    }
+    poses.check_len(len)?;
     BatchError::check_len("output", len, out.len()?)?;
     Ok(len)
 }
@@ -160,7 +164,7 @@ mod tests {
     use super::*;
     use crate::aabb::Aabb3;
     use crate::engine::{Active, Engine, Store};
-    use crate::layout::{Aabb3x8, Block8};
+    use crate::layout::{Aabb3x8, Block8, ReadMaps};
     use crate::simd::{F32s, LaneArray};
     use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};
     use alloc::{vec, vec::Vec};

@@ -7,13 +7,15 @@
 
 use rayon::prelude::*;
 
+use super::PoseSource;
 use super::{Batch, checked_len};
 use crate::aabb::Aabb3;
+use crate::engine::{AosPoses, Poses};
 use crate::error::BatchError;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, Maps, ReadBoxes, ReadMaps, TransformSource};
+use crate::layout::{BoxSink, BoxSource, ReadBoxes};
+use crate::method::{Method, Rounding};
 use crate::simd::LaneArray;
-use crate::transform::Class;
 
 /// The fewest boxes a part gets: below this the pool's overhead outweighs the work.
 const MIN_PART: usize = 4096;
@@ -54,29 +56,46 @@ impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
     }
 }
 
-impl<const N: usize, S: ReadMaps<N>> ReadMaps<N> for Window<'_, S> {
-    type Class = S::Class;
+impl<const N: usize, S: Poses<N>> Poses<N> for Window<'_, S> {
+    // The whole source's length was checked.
+    fn check_len(&self, _: usize) -> Result<(), BatchError> {
+        Ok(())
+    }
+    #[inline(always)]
+    fn tight<L: LaneArray>(
+        &self,
+        i: usize,
+        count: usize,
+        lo: Vector<L, N>,
+        hi: Vector<L, N>,
+        method: Method,
+        outward: bool,
+    ) -> (Vector<L, N>, Vector<L, N>, L) {
+        self.src
+            .tight(self.start + i, count, lo, hi, method, outward)
+    }
+    fn tight_one(
+        &self,
+        i: usize,
+        lo: [f32; N],
+        hi: [f32; N],
+        method: Method,
+        rounding: Rounding,
+    ) -> [[f32; N]; 2] {
+        self.src.tight_one(self.start + i, lo, hi, method, rounding)
+    }
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        self.src.prefetch(self.start + i);
+    }
+    const AOS: bool = S::AOS;
+    fn aos(&self) -> Option<AosPoses<'_>> {
+        self.src.aos()?.window(self.start, self.len)
+    }
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, _: usize) -> Self {
         self
-    }
-    fn len(&self) -> Result<Option<usize>, BatchError> {
-        Ok(self.src.len()?.map(|_| self.len))
-    }
-    #[inline(always)]
-    fn load<L: LaneArray>(&self, i: usize, count: usize) -> <S::Class as Class<N>>::Lanes<L> {
-        self.src.load(self.start + i, count)
-    }
-    fn get(&self, i: usize) -> S::Class {
-        self.src.get(self.start + i)
-    }
-    const MAPS: bool = S::MAPS;
-    fn maps(&self) -> Option<Maps<'_, S::Class>> {
-        match self.src.maps()? {
-            Maps::Each(items) => items.get(self.start..self.start + self.len).map(Maps::Each),
-            Maps::Shared(item) => Some(Maps::Shared(item)),
-        }
     }
 }
 
@@ -95,7 +114,7 @@ impl Batch {
     ) -> Result<(), BatchError>
     where
         B: BoxSource<N> + Sync,
-        X: TransformSource<N> + Sync,
+        X: PoseSource<N> + Sync,
         O: BoxSink<N>,
     {
         let len = checked_len(&local, &xf, &mut out)?;

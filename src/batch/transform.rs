@@ -1,25 +1,28 @@
 //! [`Batch::transform`]: the engine with every object active and the plain sink, or, for AoS
 //! 3D layouts, the AoS runs compiled here once per class.
 
+use super::PoseSource;
 use super::{AosLayouts, Batch, checked_len};
 use crate::aabb::Aabb3;
-use crate::engine::{Active, All, AosPoses, AosRun, ClassJob, Engine, Poses, Store, takes_aos};
+use crate::engine::{Active, All, AosPoses, AosRun, ClassJob, Engine, Store, takes_aos};
 use crate::error::BatchError;
-use crate::layout::{BoxSink, BoxSource, Maps, TransformSource};
+use crate::layout::{BoxSink, BoxSource, Maps};
 use crate::transform::Transform3;
 
 impl Batch {
-    /// `out[k] = local[k]` through transform `k` (or the shared transform) for every `k`:
-    /// every layout, every transform class, in 3D and 2D.
+    /// `out[k] = local[k]` through pose `k` (or the shared pose) for every `k`: every
+    /// layout, every transform class, in 3D and 2D; and the union of the boxes at two poses
+    /// ([`Swept`](crate::Swept)) or boxes relative to an `f64` origin
+    /// ([`LargeWorld`](crate::LargeWorld)), as the update takes them.
     ///
     /// # Errors
-    /// [`BatchError::LengthMismatch`] unless the boxes, the transforms (unless shared) and
+    /// [`BatchError::LengthMismatch`] unless the boxes, the poses (unless shared) and
     /// the output have the same length, and the columns of a SoA layout agree; `out` is
     /// then untouched.
     pub fn transform<const N: usize>(
         &self,
         local: impl BoxSource<N>,
-        xf: impl TransformSource<N>,
+        xf: impl PoseSource<N>,
         mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
         let len = checked_len(&local, &xf, &mut out)?;
@@ -31,7 +34,7 @@ impl Batch {
     /// site is compiled, so that AoS 3D layouts compile no lane loop there and call code
     /// compiled once in bvkit.
     #[inline(always)]
-    fn transform_checked<const N: usize, B: BoxSource<N>, X: TransformSource<N>, O: BoxSink<N>>(
+    fn transform_checked<const N: usize, B: BoxSource<N>, X: PoseSource<N>, O: BoxSink<N>>(
         &self,
         local: B,
         xf: X,
@@ -55,7 +58,7 @@ impl Batch {
     fn transform_lanes<const N: usize>(
         &self,
         local: impl BoxSource<N>,
-        xf: impl TransformSource<N>,
+        xf: impl PoseSource<N>,
         out: impl BoxSink<N>,
         len: usize,
     ) {

@@ -5,7 +5,7 @@ use super::large::LargePose;
 #[cfg(doc)]
 use super::large::LargeRigid3;
 use super::moved::Moved;
-use super::{AosLayouts, Batch};
+use super::{AosLayouts, Batch, PoseSource};
 use crate::aabb::Aabb3;
 use crate::engine::{
     Active, AosPoses, AosRun, AosSink, ClassJob, Engine, PoseList, Poses, Redo, Sink, Tight,
@@ -48,11 +48,6 @@ pub struct LargeWorld<'a, T> {
     /// The origin of the world boxes, in world units (the camera or the region's center).
     pub origin: DVec3,
 }
-
-/// Poses an update reads: any [`TransformSource`](crate::TransformSource), a [`Swept`]
-/// pair of them, or a [`LargeWorld`].
-pub trait PoseSource<const N: usize>: Poses<N> {}
-impl<const N: usize, P: Poses<N>> PoseSource<N> for P {}
 
 impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {

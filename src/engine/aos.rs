@@ -242,6 +242,24 @@ impl<'a> AosPoses<'a> {
         })
     }
 
+    /// The poses of objects `start..start + len` (a shared pose stays whole), or `None`
+    /// past the end: what one part of a parallel batch reads.
+    #[cfg(feature = "rayon")]
+    pub fn window(self, start: usize, len: usize) -> Option<Self> {
+        if self.shared {
+            return Some(self);
+        }
+        let r = start..start.checked_add(len)?;
+        let poses = match self.poses {
+            Named3::Translation3(p) => Named3::Translation3(p.get(r)?),
+            Named3::Rigid3(p) => Named3::Rigid3(p.get(r)?),
+            Named3::Similarity3(p) => Named3::Similarity3(p.get(r)?),
+            Named3::Trs3(p) => Named3::Trs3(p.get(r)?),
+            Named3::Affine3A(p) => Named3::Affine3A(p.get(r)?),
+        };
+        Some(AosPoses { poses, ..self })
+    }
+
     /// Runs `job` with the poses in their class's type.
     pub fn run(self, job: impl ClassJob<'a>) {
         fn maps<T>(poses: &[T], shared: bool) -> Maps<'_, T> {

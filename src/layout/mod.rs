@@ -36,7 +36,10 @@ impl<const N: usize, S: sealed::ReadBoxes<N>> BoxSource<N> for S {}
 pub trait BoxSink<const N: usize>: sealed::WriteBoxes<N> {}
 impl<const N: usize, S: sealed::WriteBoxes<N>> BoxSink<N> for S {}
 
-/// Transforms a batch reads: one per box in some layout, or one shared by all.
+/// Transforms in some layout: one per item, or one shared by all. A batch takes any of
+/// them as its [`PoseSource`](crate::PoseSource) (which adds swept and large-world poses);
+/// [`BoundingVolume::transformed_aabbs`](crate::BoundingVolume::transformed_aabbs), which
+/// needs the transforms themselves, takes only these.
 pub trait TransformSource<const N: usize>: sealed::ReadMaps<N> {}
 impl<const N: usize, S: sealed::ReadMaps<N>> TransformSource<N> for S {}
 
