@@ -128,7 +128,8 @@
 //! [`Batch::update`] rewrites only the fat boxes whose object left them and
 //! returns the [`Moved`] set, over [`Active`] subsets, with [`Swept`] pose pairs and
 //! large-world poses (`f64` positions, boxes relative to an `f64` origin, proven to contain
-//! the exact image).
+//! the exact image). Both verbs take the same [`PoseSource`], so [`Batch::transform`] also
+//! gives swept boxes and large-world boxes outright.
 //!
 //! ## Trees
 //! [`tree`] keeps an AABB tree per object in its own frame ([`tree::TriMesh`],
