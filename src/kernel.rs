@@ -109,7 +109,8 @@ pub(crate) fn naive<V: Axes, const N: usize>(a: &AffineLanes<V, N>, lo: V, hi: V
 ///   the product) and meets `N + 1` additions; a term of `2e'` rounds twice and meets at
 ///   most `N` (`N − 1` inside `2e'`, then one);
 ///
-/// so either way the computed `2S'` is at least `2S'·(1 − γ(N + 3))`, and the argument of
+/// so either way the computed `2S'` is at least `2S'·(1 − γ(N + 3))` (less `2N·2^-150` if
+/// products underflow, which the `2^-79` floor covers many times over), and the argument of
 /// [`outward_pad`] then applies with doubled terms.
 /// The doubled pad is at least `2^-79·k·u >= 2^-101` (`k >= 7`), so on normal-range input
 /// `2c' ∓ 2e' ∓ pad` is a multiple of `2^-125` and its half a multiple of `2^-126`: zero
@@ -126,7 +127,7 @@ pub(crate) fn abs_matrix<V: Axes, const N: usize>(
     let t2 = a.t + a.t;
     let mut world_center2 = t2;
     // Unfused, the centre's products, which the pad reuses.
-    let mut products = [t2; N];
+    let mut products = [V::splat(0.0); N];
     let mut world_extent2 = a.cols[0].abs() * extent2.axis(0);
     for (j, product) in products.iter_mut().enumerate() {
         if V::FUSES {

@@ -236,6 +236,40 @@ fn a_rebuild_spread_over_frames_misses_no_change_made_meanwhile() {
 }
 
 #[test]
+fn a_rebuild_takes_over_after_about_as_many_calls_as_it_is_spread_over() {
+    let fat: Vec<Aabb3> = (0..1000)
+        .map(|i| {
+            let c = Vec3A::new((i % 10) as f32, (i / 10 % 10) as f32, (i / 100) as f32);
+            Aabb3::new(c, c + 0.6)
+        })
+        .collect();
+    let moved: Vec<u32> = (0..1000).collect();
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    tree.set_rebuild_after(0.5);
+    // Over one call: the new hierarchy takes over in the call that starts it.
+    tree.set_rebuild_frames(1);
+    tree.write(&moved, &fat).unwrap();
+    assert!(tree.maintain());
+    assert!(!tree.maintain(), "nothing moved since");
+    // Over four: a few calls, never the first.
+    tree.set_rebuild_frames(4);
+    tree.write(&moved, &fat).unwrap();
+    let calls = (1..=20).find(|_| tree.maintain());
+    assert!(
+        matches!(calls, Some(2..=6)),
+        "took over after {calls:?} calls"
+    );
+    let mut pairs = Pairs::new();
+    tree.report(&mut pairs);
+    assert_eq!(
+        tree.overlapping_pairs(),
+        brute_force(&fat, &[true; 1000])
+            .into_iter()
+            .collect::<Vec<_>>()
+    );
+}
+
+#[test]
 fn begun_pairs_alone_match_the_reference() {
     // Without the ended pairs (the default), the begun ones are the same.
     let boxes = |shift: f32| -> Vec<Aabb3> {

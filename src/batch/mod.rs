@@ -48,6 +48,8 @@ impl<const N: usize, P: Poses<N>> PoseSource<N> for P {}
 /// | SoA columns | [`SoaRef`](crate::SoaRef), `&Soa` | [`SoaMut`](crate::SoaMut), `&mut Soa` | [`SoaRef`](crate::SoaRef), `&Soa` |
 /// | shared | | | `&T`: one transform for the whole batch |
 ///
+/// The poses can also be a [`Swept`] pair of any two of these (the union of the boxes at
+/// both) or [`LargeWorld`] poses (boxes relative to an `f64` origin), as for the update.
 /// `T` is any transform class ([`crate::Transform3`], [`crate::Transform2`]); 2D boxes
 /// (`Aabb2`) work the same way. Every combination runs the same lane-generic kernels as the
 /// single-box path and keeps the same contract; lengths are checked before anything is

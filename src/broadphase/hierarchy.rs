@@ -401,10 +401,6 @@ impl Hierarchy {
     pub(crate) fn begin_from(&mut self, from: &Hierarchy) {
         let mut centres = take(&mut self.centres);
         centres.clear();
-        // Room for as many nodes as `from` has, so that no step of a spread build moves the
-        // nodes to a larger allocation (at 1M proxies the step that did took 27 ms).
-        self.nodes.clear();
-        self.nodes.reserve(from.nodes.len());
         for node in &from.nodes {
             for k in 0..WIDTH {
                 let c = node.child[k];
@@ -414,6 +410,11 @@ impl Hierarchy {
                 }
             }
         }
+        // Room for the most nodes a build of this many proxies can take (every bottom node
+        // holding two), so that no step of a spread build moves the nodes to a larger
+        // allocation (at 1M proxies the step that did took 27 ms).
+        self.nodes.clear();
+        self.nodes.reserve(centres.len() / 2 + 1);
         self.begin_with(centres);
     }
 
@@ -434,10 +435,10 @@ impl Hierarchy {
         n * ((usize::BITS - n.leading_zeros()) as usize + PLACE_WORK)
     }
 
-    /// Runs the build begun by [`Hierarchy::begin`] for about `budget` units of work (a
-    /// split of `m` centres costs `m`, placing a proxy [`PLACE_WORK`]; a split is never cut
-    /// short), placing each proxy with
-    /// the box `box_of(id)` gives when it is placed (`None`: the proxy left, and its slot
+    /// Runs the build begun by [`Hierarchy::begin`] or [`Hierarchy::begin_from`] for about
+    /// `budget` units of work (a split of `m` centres costs `m`, placing a proxy
+    /// [`PLACE_WORK`]; a split is never cut short), placing each proxy with the box
+    /// `box_of(id)` gives when it is placed (`None`: the proxy left, and its slot
     /// stays empty). Returns true when the build is done and the unions are set.
     ///
     /// The build splits top-down at the median of the widest spread of centres until every
@@ -467,10 +468,10 @@ impl Hierarchy {
                 continue;
             }
             let n = task.node;
-            budget = budget.saturating_sub(usize::from(task.count) * PLACE_WORK);
             for k in 0..usize::from(task.count) {
                 let (start, end) = task.group(k);
                 let child = if end - start == 1 {
+                    budget = budget.saturating_sub(PLACE_WORK);
                     let id = self.centres[start].1;
                     let Some(b) = box_of(id) else { continue };
                     self.nodes[n as usize].set(k, &b);
@@ -487,11 +488,18 @@ impl Hierarchy {
             }
         }
         // Every node was allocated after its parent: one pass from the last sets the
-        // unions bottom-up.
+        // unions bottom-up, and takes out the nodes left without children (all their
+        // proxies left before they were placed), so that no empty node stays linked.
         for n in (1..self.nodes.len()).rev() {
             let node = &self.nodes[n];
             let (parent, b) = (node.parent, node.union());
-            self.nodes[parent.node() as usize].set(parent.child(), &b);
+            let empty = node.child.iter().all(|&c| c == NONE);
+            let p = &mut self.nodes[parent.node() as usize];
+            p.set(parent.child(), &b);
+            if empty {
+                p.child[parent.child()] = NONE;
+                self.free.push(n as u32);
+            }
         }
         true
     }

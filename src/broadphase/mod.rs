@@ -530,8 +530,9 @@ impl DynamicTree {
     /// Proxy `id`'s slot in the hierarchy a rebuild under way fills, once placed there.
     #[inline(always)]
     fn spare_slot(&self, id: u32) -> Option<Slot> {
+        self.rebuilding?;
         let then = *self.spare_at.get(id as usize)?;
-        (self.rebuilding.is_some() && then != ABSENT && then != PARKED).then_some(Slot(then))
+        (then != ABSENT && then != PARKED).then_some(Slot(then))
     }
 
     /// Notes that proxy `id` is inserted, removed, parked or unparked, for the rebuild under
@@ -588,8 +589,8 @@ impl DynamicTree {
         self.rebuild_after = moves_per_proxy;
     }
 
-    /// Sets over how many [`DynamicTree::maintain`] calls a rebuild is spread (default 32;
-    /// 1 rebuilds at once). Fewer frames give each a larger share of the work; more leave
+    /// Sets over about how many [`DynamicTree::maintain`] calls a rebuild is spread (default
+    /// 32; 1 rebuilds at once, in the call that starts it). Fewer frames give each a larger share of the work; more leave
     /// the old hierarchy in use longer.
     pub fn set_rebuild_frames(&mut self, frames: u32) {
         self.rebuild_frames = frames.max(1);
@@ -604,16 +605,22 @@ impl DynamicTree {
     /// pays for a whole rebuild. Until the new hierarchy takes over, each write goes to
     /// both, and proxies inserted or removed meanwhile are brought up to date in it when its
     /// build is done. Returns true when a new hierarchy took over. Boxes and pairs do not
-    /// change; the rebuild needs a second hierarchy's memory (about 57 bytes per proxy: its
-    /// nodes, the centres it sorts, the proxies' slots in it).
+    /// change; the rebuild needs a second hierarchy's memory, kept between rebuilds (its
+    /// nodes, 256 bytes per 2 to 8 proxies, the centres it sorts, 16 bytes per proxy, and
+    /// the proxies' slots in it, 4 bytes per id).
     pub fn maintain(&mut self) -> bool {
         if self.rebuilding.is_none() {
             let proxies = self.len.max(1) as f32;
             if self.moves as f32 <= self.rebuild_after * proxies {
                 return false;
             }
-            let work = Hierarchy::build_work(self.len);
-            self.begin_rebuild(work.div_ceil(self.rebuild_frames as usize).max(1));
+            let budget = match self.rebuild_frames {
+                1 => usize::MAX,
+                frames => Hierarchy::build_work(self.len)
+                    .div_ceil(frames as usize)
+                    .max(1),
+            };
+            self.begin_rebuild(budget);
         }
         self.continue_rebuild()
     }

@@ -64,7 +64,8 @@ struct Tree {
     changed: Vec<u32>,
 }
 
-/// What B does beyond A's pipeline (module docs); the default is A's tree work exactly.
+/// What B does beyond A's pipeline (module docs), and C's upkeep settings; the default is
+/// A's tree work exactly for B, and the tree's own defaults for C.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Tuning {
     /// The relative part of B's margin.
