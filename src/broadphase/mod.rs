@@ -93,6 +93,12 @@ pub enum BroadphaseError {
         /// The id.
         id: u32,
     },
+    /// The memory for ids up to this one could not be allocated (the tree keeps 12 bytes
+    /// per id up to the largest): the tree is unchanged.
+    OutOfMemory {
+        /// The id.
+        id: u32,
+    },
     /// The moved list of [`DynamicTree::write`] (or `update`) is not strictly ascending.
     Unsorted,
     /// A moved id past the end of the fat boxes.
@@ -117,6 +123,9 @@ impl fmt::Display for BroadphaseError {
             }
             Self::Duplicate { id } => write!(f, "proxy {id} is already in the tree"),
             Self::IdTooLarge { id } => write!(f, "proxy id {id} is not below 2^31 - 2"),
+            Self::OutOfMemory { id } => {
+                write!(f, "proxy id {id}: no memory for the tree's per-id tables")
+            }
             Self::Unsorted => write!(f, "the moved ids are not strictly ascending"),
             Self::MissingBox { id, len } => {
                 write!(f, "moved id {id} is past the {len} fat boxes")
@@ -376,9 +385,18 @@ impl DynamicTree {
         if id >= MAX_ID {
             return Err(BroadphaseError::IdTooLarge { id });
         }
-        if self.at.len() <= id as usize {
-            self.at.resize(id as usize + 1, ABSENT);
-            self.mark.resize(id as usize + 1, 0);
+        let len = id as usize + 1;
+        if self.at.len() < len {
+            // Reserved first, so that a refused id changes nothing; the spare's table too,
+            // which a rebuild later grows to this length where it cannot fail.
+            let more = |v: &Vec<u32>| len.saturating_sub(v.len());
+            self.at
+                .try_reserve_exact(more(&self.at))
+                .and_then(|()| self.mark.try_reserve_exact(more(&self.mark)))
+                .and_then(|()| self.spare_at.try_reserve_exact(more(&self.spare_at)))
+                .map_err(|_| BroadphaseError::OutOfMemory { id })?;
+            self.at.resize(len, ABSENT);
+            self.mark.resize(len, 0);
         }
         Ok(())
     }
@@ -416,12 +434,13 @@ impl DynamicTree {
 
     /// Adds proxy `id` with fat box `fat`; its pairs begin at the next report (if it still
     /// has a box then: see the module docs on what a report compares). The tree's memory
-    /// grows with the largest id (8 bytes per id up to it).
+    /// grows with the largest id (12 bytes per id up to it).
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
     /// [`BroadphaseError::Duplicate`] when `id` is in the tree,
-    /// [`BroadphaseError::IdTooLarge`] from `2^31 − 2` on; the tree is then unchanged.
+    /// [`BroadphaseError::IdTooLarge`] from `2^31 − 2` on, [`BroadphaseError::OutOfMemory`]
+    /// when the per-id tables cannot grow to `id`; the tree is then unchanged.
     pub fn insert(&mut self, id: u32, fat: Aabb3) -> Result<(), BroadphaseError> {
         if !accepts(&fat) {
             return Err(BroadphaseError::InvalidBox { id });
