@@ -48,7 +48,7 @@ for n in names:
 print()
 print("| ratio | " + " | ".join(sizes) + " |")
 print("|---|" + "---:|" * len(sizes))
-backends = ["avx2", "avx512", "baseline", "wide", "scalar"]  # the order of Backend::detect()
+backends = ["avx512", "avx2", "baseline", "wide", "scalar"]  # the order of Backend::detect()
 best = next((b for b in backends if any(k[1] == f"aosoa/{b}/abs-matrix/nearest" for k in rows)), None)
 
 

@@ -20,35 +20,54 @@ pub trait MapKernel<V> {
     fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V);
 }
 
-/// A map on `Vec3A` lanes (one box) that two of can share wider lanes `P`, each in its own
-/// half: the AoS loop's two boxes per instruction.
-pub trait JoinLanes: MapKernel<Vec3A> {
+/// A map on `Vec3A` lanes (one box) that `W` of can share wider lanes `P`, each in its own
+/// 128-bit part: the AoS loop's several boxes per instruction.
+pub trait JoinLanes: MapKernel<Vec3A> + Copy {
     /// The same map in lanes `P`.
     type In<P: Axes>: MapKernel<P>;
-    /// `a` and `b` side by side: every field `join(a's, b's)`.
-    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> Self::In<P>;
+    /// The maps side by side: every field `join` of the maps' own.
+    fn join<P: Axes, const W: usize>(
+        maps: &[Self; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> Self::In<P>;
 }
 
 impl JoinLanes for AffineLanes<Vec3A, 3> {
     type In<P: Axes> = AffineLanes<P, 3>;
     #[inline(always)]
-    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> AffineLanes<P, 3> {
+    fn join<P: Axes, const W: usize>(
+        maps: &[Self; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> AffineLanes<P, 3> {
         AffineLanes {
-            cols: join_cols(&a.cols, &b.cols, &join),
-            t: join(a.t, b.t),
+            cols: join_cols(maps, |m| &m.cols, &join),
+            t: join(gather(|k| maps[k].t)),
         }
     }
 }
 
-/// The three columns of two maps side by side, `join(a's, b's)` each: the columns of every
-/// [`JoinLanes`] map.
+/// `[f(0), …, f(W − 1)]`, always inlined: the AoS loop builds its groups with this rather
+/// than `core::array::from_fn` or `map`, which were compiled out of line, without the
+/// dispatch wrapper's features (a rigid AoS batch ran 2.5x slower).
 #[inline(always)]
-pub(crate) fn join_cols<P>(
-    a: &[Vec3A; 3],
-    b: &[Vec3A; 3],
-    join: impl Fn(Vec3A, Vec3A) -> P,
+pub(crate) fn gather<const W: usize, X: Copy>(mut f: impl FnMut(usize) -> X) -> [X; W] {
+    let mut out = [f(0); W];
+    for (k, x) in out.iter_mut().enumerate().skip(1) {
+        *x = f(k);
+    }
+    out
+}
+
+/// The three columns of `W` maps side by side, `join` of the maps' own each: the columns
+/// of every [`JoinLanes`] map.
+#[inline(always)]
+pub(crate) fn join_cols<M, P, const W: usize>(
+    maps: &[M; W],
+    cols: impl Fn(&M) -> &[Vec3A; 3],
+    join: impl Fn([Vec3A; W]) -> P,
 ) -> [P; 3] {
-    [join(a[0], b[0]), join(a[1], b[1]), join(a[2], b[2])]
+    let col = |j: usize| join(gather(|k| cols(&maps[k])[j]));
+    [col(0), col(1), col(2)]
 }
 
 /// An affine map `x ↦ M x + t` in lanes: `cols[j]` is column `j` of `M`.

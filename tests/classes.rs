@@ -790,10 +790,13 @@ fn backends_are_detected_and_forced() {
             assert_eq!(batch.backend(), b);
         }
     }
-    // On x86-64 with AVX2 the detected backend must be a runtime-dispatched one (without
-    // `std` there is no run-time detection: tests/features.rs covers that case).
+    // On x86-64 the detected backend is the most capable run-time-dispatched one the CPU
+    // has (without `std` there is no run-time detection: tests/features.rs covers that
+    // case).
     #[cfg(all(target_arch = "x86_64", feature = "std"))]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if Backend::Avx512.is_supported() {
+        assert_eq!(Backend::detect(), Backend::Avx512);
+    } else if Backend::Avx2.is_supported() {
         assert_eq!(Backend::detect(), Backend::Avx2);
     }
 }
@@ -875,7 +878,7 @@ fn box_bits(b: &Aabb3) -> [[u32; 3]; 2] {
     [b.min.to_array(), b.max.to_array()].map(|v| v.map(f32::to_bits))
 }
 
-/// The AoS loop runs two boxes per vector and the single-box kernel's test once per chunk of
+/// The AoS loop runs two or four boxes per vector and the single-box kernel's test once per chunk of
 /// 64, redoing a failed chunk one box at a time. Whatever the backend, the mode, the
 /// method, the rounding, the pose kind, the length (odd tails, chunk edges) and wherever
 /// the bad boxes fall, every box gets the bits of `Aabb3::transformed` on it, and an update

@@ -154,7 +154,7 @@ fn layouts3<T: Transform3, P: Exactly<3>>(
             &format!("aos {what}"),
         );
     }
-    // The AoS loop (two boxes per vector, its test taken per chunk) gives every box the
+    // The AoS loop (two or four boxes per vector, its test taken per chunk) gives every box the
     // bits of the single-box call, on every backend and in both modes.
     let bits = |b: &Aabb3| [b.min.to_array(), b.max.to_array()].map(|v| v.map(f32::to_bits));
     for ((l, x), o) in local.iter().zip(&xfs).zip(&out) {

@@ -157,11 +157,10 @@ fn checked_len<const N: usize>(
 
 #[cfg(test)]
 mod tests {
-    //! The 16-lane instantiation (the AVX-512 backend's lane type) run without AVX-512:
-    //! every lane does the same arithmetic at any width, and the tail runs in one lane of
-    //! the same arithmetic, so it must reproduce the 8-lane backends exactly. This covers
-    //! the 16-lane code paths (blocks spanning two AoSoA blocks, tails, the extended path)
-    //! on CPUs that cannot run the AVX-512 backend.
+    //! Lanes of 16 (no backend's lane type now, but the engine takes any width): every
+    //! lane does the same arithmetic at any width, and the tail runs in one lane of the
+    //! same arithmetic, so they must reproduce the 8-lane backends exactly. This covers the
+    //! wide code paths (blocks spanning two AoSoA blocks, tails, the extended path).
 
     use super::*;
     use crate::aabb::Aabb3;

@@ -17,7 +17,7 @@ use crate::lane::Vector;
 use crate::layout::Maps;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
-use crate::simd::{self, BoxPair, LaneArray};
+use crate::simd::{self, BoxGroup, LaneArray};
 use crate::transform::Transform3;
 
 use glam::DVec3;
@@ -509,12 +509,12 @@ impl AosSink for AosFat<'_> {
     /// boxes, then a loop over its set bits. A branch per object would mispredict on every
     /// object a walk moves at random; the loop mispredicts once per eight.
     #[inline(always)]
-    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
+    fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
         start: usize,
         local: &[Aabb3],
         poses: impl PoseList<'p, T>,
-        tight: Tight<P>,
+        tight: Tight<P, W>,
     ) {
         let fat = &mut self.fat[start..start + local.len()];
         for (c, (local, fat)) in local.chunks(8).zip(fat.chunks_mut(8)).enumerate() {

@@ -3,7 +3,7 @@
 //! Gathering AoS boxes and transforms into one-field-per-register lanes costs a shuffle per
 //! field per box, more than the kernel itself (measured in `docs/speed.md`). So `&[Aabb3]`
 //! boxes with AoS or shared transforms run the single-box kernel on glam's `Vec3A`
-//! layout, two boxes per vector ([`BoxPair`]: one per 128-bit half), and redo a chunk box by
+//! layout, several boxes per vector ([`BoxGroup`]: one per 128-bit part), and redo a chunk box by
 //! box with [`Aabb3::transformed`] where its test fails: the same bits as the single-box
 //! calls on every backend (which never fuse), and the same contract, the extended path
 //! included.
@@ -12,11 +12,13 @@ use core::marker::PhantomData;
 
 use super::Active;
 use super::active::{List, Mask, Subset, Width};
+use glam::Vec3A;
+
 use crate::aabb::Aabb3;
-use crate::kernel::{JoinLanes, MapKernel};
+use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::layout::Maps;
 use crate::method::{Method, Rounding};
-use crate::simd::{self, Backend, BoxPair, PairJob};
+use crate::simd::{self, Backend, BoxGroup, GroupJob};
 use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of one step of a mask's walk: a mask word's worth.
@@ -26,12 +28,12 @@ const SPAN: usize = 64;
 pub(crate) trait AosSink {
     /// Objects `start..start + local.len()`, every one active: object `start + k`'s tight
     /// box is `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
-    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
+    fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
         start: usize,
         local: &[Aabb3],
         poses: impl PoseList<'p, T>,
-        tight: Tight<P>,
+        tight: Tight<P, W>,
     );
     /// Object `i` alone, with its tight box.
     fn one(&mut self, i: usize, tight: Aabb3);
@@ -42,12 +44,12 @@ pub(crate) trait AosSink {
 /// The plain AoS sink: every tight box written.
 impl AosSink for &mut [Aabb3] {
     #[inline(always)]
-    fn run<'p, T: Transform3 + 'p, P: BoxPair>(
+    fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
         start: usize,
         local: &[Aabb3],
         poses: impl PoseList<'p, T>,
-        tight: Tight<P>,
+        tight: Tight<P, W>,
     ) {
         tight.boxes(local, poses, start, &mut self[start..start + local.len()]);
     }
@@ -64,33 +66,33 @@ impl AosSink for &mut [Aabb3] {
 /// The validity test of the AoS loop is taken once per this many objects.
 const CHUNK: usize = 64;
 
-/// The single-box kernel of one method and rounding, and its pairs `P`. A method call
-/// rather than a closure: a closure was compiled out of line, with the method as a run-time
-/// value where each loop has it as a constant.
-pub(crate) struct Tight<P> {
+/// The single-box kernel of one method and rounding, and its groups `P` of `W` boxes. A
+/// method call rather than a closure: a closure was compiled out of line, with the method as
+/// a run-time value where each loop has it as a constant.
+pub(crate) struct Tight<P, const W: usize> {
     method: Method,
     rounding: Rounding,
-    pairs: PhantomData<P>,
+    groups: PhantomData<P>,
 }
 
-impl<P> Clone for Tight<P> {
+impl<P, const W: usize> Clone for Tight<P, W> {
     fn clone(&self) -> Self {
         *self
     }
 }
-impl<P> Copy for Tight<P> {}
+impl<P, const W: usize> Copy for Tight<P, W> {}
 
-impl<P: BoxPair> Tight<P> {
+impl<P: BoxGroup<W>, const W: usize> Tight<P, W> {
     /// The tight world box of `local` at `pose`.
     #[inline(always)]
     pub fn of<T: Transform3>(self, local: &Aabb3, pose: &T) -> Aabb3 {
         local.transformed(pose, self.method, self.rounding)
     }
 
-    /// `out[k] = self.of(&local[k], poses.at(start + k))` for every `k`, two objects per
+    /// `out[k] = self.of(&local[k], poses.at(start + k))` for every `k`, `W` objects per
     /// vector of `P`. The single-box kernel's own test (`lo <= hi`, finite faces) is
     /// gathered over each chunk of [`CHUNK`] objects, and a chunk where it fails anywhere is
-    /// redone one object at a time with [`Tight::of`]. Each half of a pair runs the
+    /// redone one object at a time with [`Tight::of`]. Each part of a group runs the
     /// operations of the single-box kernel, so every object gets exactly `of`'s bits.
     #[inline(always)]
     pub fn boxes<'p, T: Transform3 + 'p>(
@@ -104,24 +106,19 @@ impl<P: BoxPair> Tight<P> {
         for (c, (local, out)) in local.chunks(CHUNK).zip(out.chunks_mut(CHUNK)).enumerate() {
             let first = start + c * CHUNK;
             let mut stands = P::all_set();
-            let pairs = local.chunks_exact(2).zip(out.chunks_exact_mut(2));
-            for ((l, o), (a, b)) in pairs.zip(poses.pairs(first)) {
-                let map = <T::Simd as JoinLanes>::join(&a.simd(), &b.simd(), P::join);
-                let (lo, hi) = (P::join(l[0].min, l[1].min), P::join(l[0].max, l[1].max));
+            let groups = local.chunks_exact(W).zip(out.chunks_exact_mut(W));
+            for ((l, o), group) in groups.zip(poses.groups::<W>(first)) {
+                let maps = gather(|k| group[k].simd());
+                let map = <T::Simd as JoinLanes>::join(&maps, P::join);
+                let lo = P::join(gather(|k| l[k].min));
+                let hi = P::join(gather(|k| l[k].max));
                 let (min, max) = map.transform(lo, hi, self.method, outward);
                 stands = P::and(stands, P::stands(lo, hi, min, max));
-                let ((min0, min1), (max0, max1)) = (min.halves(), max.halves());
-                o[0] = Aabb3 {
-                    min: min0,
-                    max: max0,
-                };
-                o[1] = Aabb3 {
-                    min: min1,
-                    max: max1,
-                };
+                for ((o, min), max) in o.iter_mut().zip(min.parts()).zip(max.parts()) {
+                    *o = Aabb3 { min, max };
+                }
             }
-            if local.len() % 2 == 1 {
-                let k = local.len() - 1;
+            for k in local.len() - local.len() % W..local.len() {
                 out[k] = self.of(&local[k], poses.at(first + k));
             }
             if !P::all_xyz(stands) {
@@ -140,8 +137,8 @@ pub(crate) trait PoseList<'p, T: 'p>: Copy {
     fn at(self, i: usize) -> &'p T;
     /// The poses of objects `start..`, in order.
     fn from(self, start: usize) -> impl Iterator<Item = &'p T>;
-    /// The poses of objects `start..`, two by two.
-    fn pairs(self, start: usize) -> impl Iterator<Item = (&'p T, &'p T)>;
+    /// The poses of objects `start..`, `W` at a time.
+    fn groups<const W: usize>(self, start: usize) -> impl Iterator<Item = [&'p T; W]>;
 }
 
 impl<'p, T> PoseList<'p, T> for &'p [T] {
@@ -154,8 +151,8 @@ impl<'p, T> PoseList<'p, T> for &'p [T] {
         self[start..].iter()
     }
     #[inline(always)]
-    fn pairs(self, start: usize) -> impl Iterator<Item = (&'p T, &'p T)> {
-        self[start..].chunks_exact(2).map(|p| (&p[0], &p[1]))
+    fn groups<const W: usize>(self, start: usize) -> impl Iterator<Item = [&'p T; W]> {
+        self[start..].chunks_exact(W).map(|g| gather(|k| &g[k]))
     }
 }
 
@@ -179,8 +176,8 @@ impl<'p, T> PoseList<'p, T> for Shared<'p, T> {
         core::iter::repeat(self.0)
     }
     #[inline(always)]
-    fn pairs(self, _: usize) -> impl Iterator<Item = (&'p T, &'p T)> {
-        core::iter::repeat((self.0, self.0))
+    fn groups<const W: usize>(self, _: usize) -> impl Iterator<Item = [&'p T; W]> {
+        core::iter::repeat([self.0; W])
     }
 }
 
@@ -280,24 +277,35 @@ impl<'a> AosPoses<'a> {
 }
 
 /// `$walk(run, poses, tight, $set)` once per method and pose kind, each specialised to its
-/// kernel, with pairs `$pairs`. The rounding is a branch the loop does not change:
-/// specialising it too doubled the library's build (20.6 to 37.6 s in release) for no
-/// measurable speed (`speed/1K` and `speed/4M` AoS rows within 5%, AMD EPYC Zen 5).
+/// kernel, with groups `$groups` of `$w` boxes; the naive baseline with one box per
+/// `Vec3A` on every backend (its eight corners in the wider groups cost the library's
+/// release build 10 s for a method kept for comparison). The rounding is a branch the loop
+/// does not change: specialising it too doubled the library's build (20.6 to 37.6 s in
+/// release) for no measurable speed (`speed/1K` and `speed/4M` AoS rows within 5%, AMD EPYC
+/// Zen 5).
 macro_rules! each_kernel {
-    ($run:expr, $maps:expr, $pairs:ty, $walk:ident $(, $set:expr)?) => {{
-        let len = $run.local.len();
-        let rounding = $run.rounding;
-        specialise!($run.method, |method| {
-            let tight = Tight::<$pairs> {
-                method,
-                rounding,
-                pairs: PhantomData,
-            };
-            match $maps {
-                Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
-                Maps::Shared(pose) => $walk($run, Shared(pose), tight $(, $set)?),
+    ($run:expr, $maps:expr, $w:ident, $groups:ty, $walk:ident $(, $set:expr)?) => {{
+        match $run.method {
+            Method::AbsMatrix => {
+                each_kernel!(@with $run, $maps, Method::AbsMatrix, $w, $groups, $walk $(, $set)?)
             }
-        })
+            Method::SignSelect => {
+                each_kernel!(@with $run, $maps, Method::SignSelect, $w, $groups, $walk $(, $set)?)
+            }
+            Method::Naive => each_kernel!(@with $run, $maps, Method::Naive, 1, Vec3A, $walk $(, $set)?),
+        }
+    }};
+    (@with $run:expr, $maps:expr, $method:expr, $w:expr, $groups:ty, $walk:ident $(, $set:expr)?) => {{
+        let len = $run.local.len();
+        let tight = Tight::<$groups, $w> {
+            method: $method,
+            rounding: $run.rounding,
+            groups: PhantomData,
+        };
+        match $maps {
+            Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
+            Maps::Shared(pose) => $walk($run, Shared(pose), tight $(, $set)?),
+        }
     }};
 }
 
@@ -324,7 +332,7 @@ impl AosActive for All {
         maps: Maps<'_, T>,
         backend: Backend,
     ) {
-        simd::dispatch_pairs(backend, Every { run, maps });
+        simd::dispatch_groups(backend, Every { run, maps });
     }
 }
 
@@ -339,9 +347,10 @@ impl AosActive for Active<'_> {
         backend: Backend,
     ) {
         match run.active {
-            Active::All => simd::dispatch_pairs(backend, Every { run, maps }),
-            Active::Indices(ix) => simd::dispatch_pairs(backend, Listed { run, maps, ix }),
-            Active::Mask(words) => simd::dispatch_pairs(backend, Masked { run, maps, words }),
+            Active::All => simd::dispatch_groups(backend, Every { run, maps }),
+            // A list runs one object at a time, in no group: compiled once, for the baseline.
+            Active::Indices(ix) => Listed { run, maps, ix }.run::<1, Vec3A>(),
+            Active::Mask(words) => simd::dispatch_groups(backend, Masked { run, maps, words }),
         }
     }
 }
@@ -352,10 +361,10 @@ struct Every<'a, 'm, S, A, T> {
     maps: Maps<'m, T>,
 }
 
-impl<S: AosSink, A, T: Transform3> PairJob for Every<'_, '_, S, A, T> {
+impl<S: AosSink, A, T: Transform3> GroupJob for Every<'_, '_, S, A, T> {
     #[inline(always)]
-    fn run<P: BoxPair>(self) {
-        each_kernel!(self.run, self.maps, P, whole);
+    fn run<const W: usize, P: BoxGroup<W>>(self) {
+        each_kernel!(self.run, self.maps, W, P, whole);
     }
 }
 
@@ -366,10 +375,10 @@ struct Listed<'a, 'm, S, T> {
     ix: &'a [u32],
 }
 
-impl<S: AosSink, T: Transform3> PairJob for Listed<'_, '_, S, T> {
+impl<S: AosSink, T: Transform3> GroupJob for Listed<'_, '_, S, T> {
     #[inline(always)]
-    fn run<P: BoxPair>(self) {
-        each_kernel!(self.run, self.maps, P, list, self.ix);
+    fn run<const W: usize, P: BoxGroup<W>>(self) {
+        each_kernel!(self.run, self.maps, W, P, list, self.ix);
     }
 }
 
@@ -380,19 +389,19 @@ struct Masked<'a, 'm, S, T> {
     words: &'a [u64],
 }
 
-impl<S: AosSink, T: Transform3> PairJob for Masked<'_, '_, S, T> {
+impl<S: AosSink, T: Transform3> GroupJob for Masked<'_, '_, S, T> {
     #[inline(always)]
-    fn run<P: BoxPair>(self) {
-        each_kernel!(self.run, self.maps, P, mask, self.words);
+    fn run<const W: usize, P: BoxGroup<W>>(self) {
+        each_kernel!(self.run, self.maps, W, P, mask, self.words);
     }
 }
 
 /// [`Every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, S: AosSink, A, P: BoxPair>(
+fn whole<'p, T: Transform3 + 'p, S: AosSink, A, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_, S, A>,
     poses: impl PoseList<'p, T>,
-    tight: Tight<P>,
+    tight: Tight<P, W>,
 ) {
     let AosRun {
         local, mut sink, ..
@@ -417,10 +426,10 @@ fn request<'p, T: 'p, S: AosSink>(
 /// list cost more than the objects: 1.4x at 1% and 10% active, measured on an Intel
 /// Xeon). Their memory is requested ahead, one object further as each runs.
 #[inline(always)]
-fn list<'p, T: Transform3 + 'p, S: AosSink, P: BoxPair>(
+fn list<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
-    tight: Tight<P>,
+    tight: Tight<P, W>,
     ix: &[u32],
 ) {
     let AosRun {
@@ -444,10 +453,10 @@ fn list<'p, T: Transform3 + 'p, S: AosSink, P: BoxPair>(
 /// one at a time. The scattered objects' memory is requested ahead, one object further as
 /// each runs.
 #[inline(always)]
-fn mask<'p, T: Transform3 + 'p, S: AosSink, P: BoxPair>(
+fn mask<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_, S, Active<'_>>,
     poses: impl PoseList<'p, T>,
-    tight: Tight<P>,
+    tight: Tight<P, W>,
     words: &[u64],
 ) {
     let AosRun {

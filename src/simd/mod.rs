@@ -8,15 +8,15 @@
 //! is no run-time detection: a backend is supported when the build's target features
 //! guarantee it (`-C target-cpu=…` or `-C target-feature=+avx2,+fma`).
 
+mod group;
 mod lanes;
-mod pair;
 
 use alloc::vec::Vec;
 
+pub(crate) use group::BoxGroup;
 #[cfg(target_arch = "x86_64")]
 use lanes::Avx8;
 pub(crate) use lanes::{F32s, LaneArray};
-pub(crate) use pair::BoxPair;
 
 /// A code path for the batch kernels.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -30,7 +30,9 @@ pub enum Backend {
     /// 8 lanes in one 256-bit AVX register, compiled for AVX2 with FMA, chosen at run time
     /// (x86-64).
     Avx2,
-    /// Lane arrays of 16 compiled for AVX-512F, AVX2 and FMA, chosen at run time (x86-64).
+    /// AVX-512F with AVX2 and FMA, chosen at run time (x86-64): the AoS loop runs four boxes
+    /// per 512-bit register, and the lane loop runs [`Backend::Avx2`]'s 8 lanes (16 lanes
+    /// of plain arrays measured 1.6x slower than them, `docs/batch.md`).
     Avx512,
     /// `wide::f32x8`: its instructions fixed at compile time by the build's target
     /// features (two SSE halves on a default x86-64 build, AVX with `target-cpu=native`).
@@ -77,13 +79,10 @@ impl Backend {
     /// The fastest supported backend, detected on first use and cached (without `std`:
     /// the fastest the build's target features guarantee).
     ///
-    /// AVX2+FMA comes first: the 16-lane instantiation measured slower than the 8-lane one
-    /// on AVX-512 machines (`docs/batch.md`), so [`Backend::Avx512`] is only used when
-    /// forced with [`crate::Batch::on`] until its lanes are tuned.
     #[must_use]
     pub fn detect() -> Backend {
         let fastest = || {
-            [Backend::Avx2, Backend::Avx512, Backend::Baseline]
+            [Backend::Avx512, Backend::Avx2, Backend::Baseline]
                 .into_iter()
                 .find(|b| b.is_supported())
                 .unwrap_or(Backend::Scalar)
@@ -102,8 +101,7 @@ impl Backend {
     pub const fn lanes(self) -> usize {
         match self {
             Backend::Scalar => 1,
-            Backend::Baseline | Backend::Avx2 | Backend::Wide => 8,
-            Backend::Avx512 => 16,
+            Backend::Baseline | Backend::Avx2 | Backend::Avx512 | Backend::Wide => 8,
         }
     }
 
@@ -165,52 +163,59 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
         (Backend::Scalar, _) => job.run::<f32>(),
         (Backend::Baseline, _) | (Backend::Wide, false) => job.run::<F32s<8, false>>(),
         (Backend::Wide, true) => job.run::<wide::f32x8>(),
+        // The AVX-512 backend runs the AVX2 lanes here: its own width is in the AoS loop
+        // (`dispatch_groups`).
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked `Backend::Avx2.is_supported()`: the CPU has every
-        // feature of `Backend::Avx2.features()`, the set `run_avx2` enables.
-        (Backend::Avx2, true) => unsafe { run_avx2::<J, Avx8<true>>(job) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        (Backend::Avx2, false) => unsafe { run_avx2::<J, Avx8<false>>(job) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked `Backend::Avx512.is_supported()`: the CPU has every
-        // feature of `Backend::Avx512.features()`, the set `run_avx512` enables.
-        (Backend::Avx512, true) => unsafe { run_avx512::<J, F32s<16, true>>(job) },
+        // SAFETY: the caller checked that `backend` is supported: the CPU has every feature
+        // of `Backend::Avx2.features()`, the set `run_avx2` enables (those of
+        // `Backend::Avx512.features()` include them).
+        (Backend::Avx2 | Backend::Avx512, true) => unsafe { run_avx2::<J, Avx8<true>>(job) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        (Backend::Avx512, false) => unsafe { run_avx512::<J, F32s<16, false>>(job) },
+        (Backend::Avx2 | Backend::Avx512, false) => unsafe { run_avx2::<J, Avx8<false>>(job) },
         #[cfg(not(target_arch = "x86_64"))]
         (Backend::Avx2 | Backend::Avx512, _) => job.run::<F32s<8, false>>(),
     }
 }
 
-/// A job over AoS 3D boxes, written once over a [`BoxPair`] (two boxes per vector).
-pub(crate) trait PairJob {
-    /// Runs the job with pairs `P`; `#[inline(always)]`, as for [`Job::run`].
-    fn run<P: BoxPair>(self);
+/// A job over AoS 3D boxes, written once over a [`BoxGroup`] of `W` boxes per vector.
+pub(crate) trait GroupJob {
+    /// Runs the job with groups `P`; `#[inline(always)]`, as for [`Job::run`].
+    fn run<const W: usize, P: BoxGroup<W>>(self);
 }
 
-/// Runs `job` on `backend`, which the caller has checked is supported: two boxes per AVX
-/// register on the AVX2 and AVX-512 backends, two SSE registers elsewhere. The arithmetic is
-/// `Vec3A`'s in both, so every backend gives the same bits.
-#[allow(unsafe_code)] // calling the `#[target_feature]` wrapper
-pub(crate) fn dispatch_pairs<J: PairJob>(backend: Backend, job: J) {
+/// Runs `job` on `backend`, which the caller has checked is supported: four boxes per
+/// AVX-512 register on the AVX-512 backend, two per AVX register on the AVX2 backend, one
+/// per `Vec3A` elsewhere. The arithmetic is `Vec3A`'s in each, so every backend gives
+/// the same bits.
+#[allow(unsafe_code)] // calling the `#[target_feature]` wrappers
+pub(crate) fn dispatch_groups<J: GroupJob>(backend: Backend, job: J) {
     debug_assert!(backend.is_supported());
     match backend {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked that `backend` is supported, and the features of both
-        // `Backend::Avx2` and `Backend::Avx512` include AVX2 and FMA, the set
-        // `run_avx2_pairs` enables.
-        Backend::Avx2 | Backend::Avx512 => unsafe { run_avx2_pairs(job) },
-        _ => job.run::<pair::Two>(),
+        // SAFETY: the caller checked that `backend` is supported: the CPU has every feature
+        // of `Backend::Avx2.features()`, the set `run_avx2_pairs` enables.
+        Backend::Avx2 => unsafe { run_avx2_pairs(job) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above, with `Backend::Avx512.features()` and `run_avx512_quads`.
+        Backend::Avx512 => unsafe { run_avx512_quads(job) },
+        _ => job.run::<1, glam::Vec3A>(),
     }
 }
 
 // The features enabled here are those of `Backend::Avx2.features()` (a test checks they agree).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn run_avx2_pairs<J: PairJob>(job: J) {
-    job.run::<pair::AvxPair>();
+fn run_avx2_pairs<J: GroupJob>(job: J) {
+    job.run::<2, group::AvxPair>();
+}
+
+// The features enabled here are those of `Backend::Avx512.features()` (a test checks they
+// agree).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx2,fma")]
+fn run_avx512_quads<J: GroupJob>(job: J) {
+    job.run::<4, group::Avx512Quad>();
 }
 
 /// A job that ignores the lane type: plain array code, compiled with the features of the
@@ -242,13 +247,6 @@ pub(crate) fn plain<T: Default>(f: impl FnOnce() -> T) -> T {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn run_avx2<J: Job, L: LaneArray>(job: J) {
-    job.run::<L>();
-}
-
-// The features enabled here are `Backend::Avx512.features()` (a test checks they agree).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx2,fma")]
-fn run_avx512<J: Job, L: LaneArray>(job: J) {
     job.run::<L>();
 }
 
@@ -294,8 +292,8 @@ mod tests {
         let source = include_str!("mod.rs");
         for (backend, wrapper) in [
             (Backend::Avx2, "run_avx2"),
-            (Backend::Avx512, "run_avx512"),
             (Backend::Avx2, "run_avx2_pairs"),
+            (Backend::Avx512, "run_avx512_quads"),
         ] {
             let at = source
                 .find(&alloc::format!("fn {wrapper}<"))

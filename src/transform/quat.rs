@@ -214,12 +214,15 @@ impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatLanes<V, SCALED> {
 impl<const SCALED: bool> JoinLanes for QuatLanes<Vec3A, SCALED> {
     type In<P: Axes> = QuatLanes<P, SCALED>;
     #[inline(always)]
-    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> QuatLanes<P, SCALED> {
+    fn join<P: Axes, const W: usize>(
+        maps: &[Self; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> QuatLanes<P, SCALED> {
         QuatLanes {
-            cols: kernel::join_cols(&a.cols, &b.cols, &join),
-            rho: join(a.rho, b.rho),
-            scale: join(a.scale, b.scale),
-            t: join(a.t, b.t),
+            cols: kernel::join_cols(maps, |m| &m.cols, &join),
+            rho: join(kernel::gather(|k| maps[k].rho)),
+            scale: join(kernel::gather(|k| maps[k].scale)),
+            t: join(kernel::gather(|k| maps[k].t)),
         }
     }
 }

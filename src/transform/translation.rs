@@ -92,8 +92,13 @@ pub struct TranslationLanes<V> {
 impl JoinLanes for TranslationLanes<Vec3A> {
     type In<P: Axes> = TranslationLanes<P>;
     #[inline(always)]
-    fn join<P: Axes>(a: &Self, b: &Self, join: impl Fn(Vec3A, Vec3A) -> P) -> TranslationLanes<P> {
-        TranslationLanes { t: join(a.t, b.t) }
+    fn join<P: Axes, const W: usize>(
+        maps: &[Self; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> TranslationLanes<P> {
+        TranslationLanes {
+            t: join(kernel::gather(|k| maps[k].t)),
+        }
     }
 }
 
