@@ -3,17 +3,17 @@
 //! Gathering AoS boxes and transforms into one-field-per-register lanes costs a shuffle per
 //! field per box, more than the kernel itself (measured in `docs/speed.md`). So `&[Aabb3]`
 //! boxes with AoS or shared transforms run the single-box kernel on glam's `Vec3A`
-//! layout, several boxes per vector ([`BoxGroup`]: one per 128-bit part), and redo a chunk box by
-//! box with [`Aabb3::transformed`] where its test fails: the same bits as the single-box
+//! layout, several boxes per vector ([`BoxGroup`]: one per 128-bit part), and redo a chunk
+//! box by box with [`Aabb3::transformed`] where its test fails: the same bits as the single-box
 //! calls on every backend (which never fuse), and the same contract, the extended path
 //! included.
 
 use core::marker::PhantomData;
 
-use super::Active;
-use super::active::{List, Mask, Subset, Width};
 use glam::Vec3A;
 
+use super::Active;
+use super::active::{List, Mask, Subset, Width};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::layout::Maps;
@@ -292,10 +292,13 @@ macro_rules! each_kernel {
             Method::SignSelect => {
                 each_kernel!(@with $run, $maps, Method::SignSelect, $w, $groups, $walk $(, $set)?)
             }
-            Method::Naive => each_kernel!(@with $run, $maps, Method::Naive, 1, Vec3A, $walk $(, $set)?),
+            Method::Naive => {
+                each_kernel!(@with $run, $maps, Method::Naive, 1, Vec3A, $walk $(, $set)?)
+            }
         }
     }};
-    (@with $run:expr, $maps:expr, $method:expr, $w:expr, $groups:ty, $walk:ident $(, $set:expr)?) => {{
+    (@with $run:expr, $maps:expr, $method:expr, $w:expr, $groups:ty, $walk:ident
+        $(, $set:expr)?) => {{
         let len = $run.local.len();
         let tight = Tight::<$groups, $w> {
             method: $method,
