@@ -185,8 +185,8 @@ pub(crate) trait GroupJob {
 }
 
 /// Runs `job` on `backend`, which the caller has checked is supported: four boxes per
-/// AVX-512 register on the AVX-512 backend, two per AVX register on the AVX2 backend, one
-/// per `Vec3A` elsewhere. The arithmetic is `Vec3A`'s in each, so every backend gives
+/// AVX-512 register on the AVX-512 backend, two per AVX register on the AVX2 backend, two
+/// SSE registers elsewhere. The arithmetic is `Vec3A`'s in each, so every backend gives
 /// the same bits.
 #[allow(unsafe_code)] // calling the `#[target_feature]` wrappers
 pub(crate) fn dispatch_groups<J: GroupJob>(backend: Backend, job: J) {
@@ -199,7 +199,7 @@ pub(crate) fn dispatch_groups<J: GroupJob>(backend: Backend, job: J) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above, with `Backend::Avx512.features()` and `run_avx512_quads`.
         Backend::Avx512 => unsafe { run_avx512_quads(job) },
-        _ => job.run::<1, glam::Vec3A>(),
+        _ => job.run::<2, group::Two>(),
     }
 }
 
