@@ -277,25 +277,17 @@ impl<'a> AosPoses<'a> {
 }
 
 /// `$walk(run, poses, tight, $set)` once per method and pose kind, each specialised to its
-/// kernel, with groups `$groups` of `$w` boxes; the naive baseline with one box per
-/// `Vec3A` on every backend (its eight corners in the wider groups cost the library's
-/// release build 10 s for a method kept for comparison). The rounding is a branch the loop
-/// does not change: specialising it too doubled the library's build (20.6 to 37.6 s in
-/// release) for no measurable speed (`speed/1K` and `speed/4M` AoS rows within 5%, AMD EPYC
-/// Zen 5).
+/// kernel, with groups `$groups` of `$w` boxes (the naive baseline too: one box per
+/// `Vec3A` would have saved the library's release build 3 s and run it 1.7x slower, a cost
+/// that the trade report would then have charged to the method). The rounding is a branch
+/// the loop does not change: specialising it too doubled the library's build (20.6 to
+/// 37.6 s in release) for no measurable speed (`speed/1K` and `speed/4M` AoS rows within 5%,
+/// AMD EPYC Zen 5).
 macro_rules! each_kernel {
     ($run:expr, $maps:expr, $w:ident, $groups:ty, $walk:ident $(, $set:expr)?) => {{
-        match $run.method {
-            Method::AbsMatrix => {
-                each_kernel!(@with $run, $maps, Method::AbsMatrix, $w, $groups, $walk $(, $set)?)
-            }
-            Method::SignSelect => {
-                each_kernel!(@with $run, $maps, Method::SignSelect, $w, $groups, $walk $(, $set)?)
-            }
-            Method::Naive => {
-                each_kernel!(@with $run, $maps, Method::Naive, 1, Vec3A, $walk $(, $set)?)
-            }
-        }
+        specialise!($run.method, |method| {
+            each_kernel!(@with $run, $maps, method, $w, $groups, $walk $(, $set)?)
+        })
     }};
     (@with $run:expr, $maps:expr, $method:expr, $w:expr, $groups:ty, $walk:ident
         $(, $set:expr)?) => {{

@@ -136,7 +136,7 @@ impl BoxGroup<2> for Two {
     }
 }
 
-/// One box per `Vec3A`: the naive method's group and an index list's, on any backend.
+/// One box per `Vec3A`: the group of an index list, which runs one object at a time.
 impl BoxGroup<1> for Vec3A {
     type Mask = BVec3A;
     #[inline(always)]
