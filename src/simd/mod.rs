@@ -78,7 +78,6 @@ impl Backend {
 
     /// The fastest supported backend, detected on first use and cached (without `std`:
     /// the fastest the build's target features guarantee).
-    ///
     #[must_use]
     pub fn detect() -> Backend {
         let fastest = || {
