@@ -303,6 +303,53 @@ fn begun_pairs_alone_match_the_reference() {
 }
 
 #[test]
+fn a_build_fills_its_nodes() {
+    // A full tree of eight children per node over n proxies has ⌈n/8⌉ bottom nodes, ⌈n/64⌉
+    // above them, and so on up to the root: a build takes no more, whatever the counts
+    // (including those one past a power of eight) and the boxes' layout.
+    let mut rng = StdRng::seed_from_u64(48);
+    for n in [1usize, 2, 8, 9, 63, 64, 65, 511, 512, 513, 4097, 30_000] {
+        let boxes: Vec<Aabb3> = (0..n)
+            .map(|_| {
+                let c = Vec3A::new(
+                    rng.random_range(-50.0..50.0),
+                    rng.random_range(-50.0..50.0),
+                    rng.random_range(-2.0..2.0),
+                );
+                Aabb3::new(c - 0.5, c + 0.5)
+            })
+            .collect();
+        let mut full = 0;
+        let mut level = n;
+        loop {
+            level = level.div_ceil(8);
+            full += level;
+            if level == 1 {
+                break;
+            }
+        }
+        let mut tree = DynamicTree::from_boxes(&boxes).unwrap();
+        assert!(
+            tree.nodes() <= full,
+            "{n} proxies: {} nodes, a full tree has {full}",
+            tree.nodes()
+        );
+        tree.rebuild();
+        assert!(
+            tree.nodes() <= full,
+            "{n} proxies rebuilt: {} nodes",
+            tree.nodes()
+        );
+        // And every proxy is still found by its own box.
+        for (i, b) in boxes.iter().enumerate() {
+            let mut found = false;
+            tree.query(b, |id| found |= id == i as u32);
+            assert!(found, "{n} proxies: proxy {i} lost");
+        }
+    }
+}
+
+#[test]
 fn empty_boxes_stay_out_and_queries_see_only_proxies() {
     // 1001 bodies in AoSoA blocks: the last block's padding lanes hold the empty box, and
     // so does body 5 (no geometry). Neither enters the tree.

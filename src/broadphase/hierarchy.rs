@@ -195,7 +195,13 @@ impl Hierarchy {
     /// and the parent).
     #[inline(always)]
     pub(crate) fn prefetch(&self, slot: Slot) {
-        if let Some(node) = self.nodes.get(slot.node() as usize) {
+        self.prefetch_node(slot.node());
+    }
+
+    /// Asks for the cache lines of node `n` (all four).
+    #[inline(always)]
+    fn prefetch_node(&self, n: u32) {
+        if let Some(node) = self.nodes.get(n as usize) {
             crate::simd::prefetch(&node.min[0]);
             crate::simd::prefetch(&node.min[2]);
             crate::simd::prefetch(&node.max[1]);
@@ -341,26 +347,62 @@ impl Hierarchy {
 
     /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with `stack` as scratch.
     #[inline(always)]
-    pub(crate) fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
-        let q = Query::new(q);
+    pub(crate) fn query(&self, q: &Aabb3, stack: &mut Vec<u64>, mut hit: impl FnMut(u32, &Aabb3)) {
+        self.query_group(core::slice::from_ref(q), stack, |_, id, b| hit(id, b));
+    }
+
+    /// Calls `hit(i, id, box)` for every query `qs[i]` and every proxy whose box overlaps
+    /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query`] per box, but
+    /// the queries descend together, so a node that several of them reach is read once.
+    /// Each stack entry carries the queries that reached it (a node, then a byte of them);
+    /// at most [`WIDTH`] queries.
+    #[inline(always)]
+    pub(crate) fn query_group(
+        &self,
+        qs: &[Aabb3],
+        stack: &mut Vec<u64>,
+        mut hit: impl FnMut(usize, u32, &Aabb3),
+    ) {
+        debug_assert!(qs.len() <= WIDTH);
+        let mut splat = [const { None }; WIDTH];
+        for (s, q) in splat.iter_mut().zip(qs) {
+            *s = Some(Query::new(q));
+        }
         stack.clear();
-        stack.push(0);
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n as usize];
-            let mut bits = node.overlaps(&q);
-            while bits != 0 {
-                let k = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
+        stack.push((1u64 << qs.len()) - 1);
+        while let Some(entry) = stack.pop() {
+            let node = &self.nodes[(entry >> 8) as usize];
+            // Per child, the queries that go down into it.
+            let mut down = [0u8; WIDTH];
+            let mut any = 0u32;
+            let mut active = entry as u8;
+            while active != 0 {
+                let i = active.trailing_zeros() as usize;
+                active &= active - 1;
+                let Some(q) = &splat[i] else { continue };
+                let mut bits = node.overlaps(q);
+                while bits != 0 {
+                    let k = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let c = node.child[k];
+                    if c == NONE {
+                        // An empty slot (+∞ below −∞) meets only a query reaching both.
+                        continue;
+                    }
+                    if c & LEAF != 0 {
+                        hit(i, c & !LEAF, &node.get(k));
+                    } else {
+                        down[k] |= 1 << i;
+                        any |= 1 << k;
+                    }
+                }
+            }
+            while any != 0 {
+                let k = any.trailing_zeros() as usize;
+                any &= any - 1;
                 let c = node.child[k];
-                if c == NONE {
-                    // An empty slot (+∞ below −∞) meets only a query reaching both.
-                    continue;
-                }
-                if c & LEAF != 0 {
-                    hit(c & !LEAF, &node.get(k));
-                } else {
-                    stack.push(c);
-                }
+                self.prefetch_node(c);
+                stack.push(u64::from(c) << 8 | u64::from(down[k]));
             }
         }
     }
@@ -410,11 +452,11 @@ impl Hierarchy {
                 }
             }
         }
-        // Room for the most nodes a build of this many proxies can take (every bottom node
-        // holding two), so that no step of a spread build moves the nodes to a larger
+        // Room for the nodes of a full tree over this many proxies, the most a build takes
+        // (see [`Task`]), so that no step of a spread build moves the nodes to a larger
         // allocation (at 1M proxies the step that did took 27 ms).
         self.nodes.clear();
-        self.nodes.reserve(centres.len() / 2 + 1);
+        self.nodes.reserve(full_tree_nodes(centres.len()));
         self.begin_with(centres);
     }
 
@@ -441,9 +483,9 @@ impl Hierarchy {
     /// `box_of(id)` gives when it is placed (`None`: the proxy left, and its slot
     /// stays empty). Returns true when the build is done and the unions are set.
     ///
-    /// The build splits top-down at the median of the widest spread of centres until every
-    /// node has eight children: balanced, so its depth is about `log8(n)` whatever the
-    /// distribution. Every placed proxy's slot goes to `places`.
+    /// The build splits top-down near the median of the widest spread of centres until every
+    /// node has eight children (see [`Task`]): balanced, so its depth is `⌈log8 n⌉` whatever
+    /// the distribution. Every placed proxy's slot goes to `places`.
     pub(crate) fn step(
         &mut self,
         mut budget: usize,
@@ -455,10 +497,12 @@ impl Hierarchy {
                 self.tasks.push(task);
                 return false;
             }
-            // Up to eight groups, each the split of the largest one at its median.
+            // Up to eight groups, each the split of the largest one near its median, at a
+            // whole number of units.
             let (g, (start, end)) = task.largest();
-            if usize::from(task.count) < WIDTH && end - start >= 2 {
-                let mid = start + (end - start) / 2;
+            let unit = task.unit as usize;
+            if usize::from(task.count) < WIDTH && end - start > unit {
+                let mid = start + (end - start).div_ceil(unit) / 2 * unit;
                 split_at_median(&mut self.centres[start..end], mid - start);
                 task.groups[g] = (start as u32, mid as u32);
                 task.groups[usize::from(task.count)] = (mid as u32, end as u32);
@@ -517,21 +561,33 @@ impl Hierarchy {
 const PLACE_WORK: usize = 16;
 
 /// A node of a build being filled: its groups of centres, split until there are eight.
+///
+/// Each group but one holds a whole number of units, the most proxies a subtree one level
+/// shallower can hold (`8^(⌈log8 n⌉ − 1)` for `n` centres), so that every node of the tree
+/// is full but those on one path per node: at most [`full_tree_nodes`], about `n / 7`, at
+/// depth `⌈log8 n⌉`. (Splits at the plain median left bottom nodes of two or three proxies:
+/// 37,449 nodes for 100K proxies, against 14,288 now.)
 #[derive(Clone, Copy, Debug)]
 struct Task {
     node: u32,
     groups: [(u32, u32); WIDTH],
     count: u8,
+    unit: u32,
 }
 
 impl Task {
     fn new(start: usize, end: usize) -> Self {
         let mut groups = [(0, 0); WIDTH];
         groups[0] = (start as u32, end as u32);
+        let mut unit = 1;
+        while unit * WIDTH < end - start {
+            unit *= WIDTH;
+        }
         Self {
             node: 0,
             groups,
             count: 1,
+            unit: unit as u32,
         }
     }
 
@@ -546,6 +602,19 @@ impl Task {
             .map(|k| (k, self.group(k)))
             .max_by_key(|(_, (s, e))| e - s)
             .unwrap_or((0, (0, 0)))
+    }
+}
+
+/// The nodes of a full tree over `n` proxies: `⌈n/8⌉` above the proxies, `⌈n/64⌉` above
+/// those, and so on up to the root.
+fn full_tree_nodes(n: usize) -> usize {
+    let (mut level, mut nodes) = (n, 0);
+    loop {
+        level = level.div_ceil(WIDTH);
+        nodes += level;
+        if level <= 1 {
+            return nodes.max(1);
+        }
     }
 }
 

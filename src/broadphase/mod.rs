@@ -256,7 +256,7 @@ pub struct DynamicTree {
     rebuild_frames: u32,
     /// Scratch: the order of the changes, the query stack.
     order: Vec<u64>,
-    stack: Vec<u32>,
+    stack: Vec<u64>,
 }
 
 impl Default for DynamicTree {
@@ -625,8 +625,8 @@ impl DynamicTree {
     /// both, and proxies inserted or removed meanwhile are brought up to date in it when its
     /// build is done. Returns true when a new hierarchy took over. Boxes and pairs do not
     /// change; the rebuild needs a second hierarchy's memory, kept between rebuilds (its
-    /// nodes, 256 bytes per 2 to 8 proxies, the centres it sorts, 16 bytes per proxy, and
-    /// the proxies' slots in it, 4 bytes per id).
+    /// nodes, 256 bytes per about 7 proxies after a build, the centres it sorts, 16 bytes
+    /// per proxy, and the proxies' slots in it, 4 bytes per id).
     pub fn maintain(&mut self) -> bool {
         if self.rebuilding.is_none() {
             let proxies = self.len.max(1) as f32;
@@ -808,11 +808,53 @@ impl View<'_> {
             at => self.hierarchy.get(Slot(at)),
         }
     }
+}
 
-    /// Calls `hit(id, box)` for every placed proxy whose box overlaps `q`.
+/// Up to [`hierarchy::WIDTH`] changes, each with its query box and the box its hits are
+/// compared with, taken in slot order, so that they are neighbours in the tree and their
+/// queries descend together ([`Hierarchy::query_group`]).
+struct Group<'c> {
+    changes: [Option<(&'c Change, Aabb3)>; hierarchy::WIDTH],
+    boxes: [Aabb3; hierarchy::WIDTH],
+    len: usize,
+}
+
+impl<'c> Group<'c> {
+    fn new() -> Self {
+        Self {
+            changes: [None; hierarchy::WIDTH],
+            boxes: [Aabb3::EMPTY; hierarchy::WIDTH],
+            len: 0,
+        }
+    }
+
+    /// Adds a change, its query box and the box its hits are compared with; true when the
+    /// group is full.
     #[inline(always)]
-    fn query(&self, q: &Aabb3, stack: &mut Vec<u32>, mut hit: impl FnMut(u32, &Aabb3)) {
-        self.hierarchy.query(q, stack, &mut hit);
+    fn push(&mut self, c: &'c Change, q: Aabb3, against: Aabb3) -> bool {
+        self.changes[self.len] = Some((c, against));
+        self.boxes[self.len] = q;
+        self.len += 1;
+        self.len == hierarchy::WIDTH
+    }
+
+    /// Calls `hit(change, against, other, box)` for every proxy whose box overlaps a
+    /// change's query box, then empties the group.
+    #[inline(always)]
+    fn query(
+        &mut self,
+        view: &View<'_>,
+        stack: &mut Vec<u64>,
+        mut hit: impl FnMut(&'c Change, &Aabb3, u32, &Aabb3),
+    ) {
+        let changes = &self.changes;
+        view.hierarchy
+            .query_group(&self.boxes[..self.len], stack, |i, other, b| {
+                if let Some((c, against)) = &changes[i] {
+                    hit(c, against, other, b);
+                }
+            });
+        self.len = 0;
     }
 }
 
@@ -825,28 +867,29 @@ fn search(
     changes: &[Change],
     order: &[u64],
     view: &View<'_>,
-    stack: &mut Vec<u32>,
+    stack: &mut Vec<u64>,
     begun: &mut Vec<(u32, u32)>,
 ) {
-    for (c, new) in in_order(changes, order, view) {
-        if new.min.x > new.max.x {
-            continue;
+    let mut hit = |c: &Change, old: &Aabb3, other: u32, b: &Aabb3| {
+        if other == c.id {
+            return;
         }
-        let old = c.old();
-        view.query(&new, stack, |other, b| {
-            if other == c.id {
-                return;
-            }
-            let was = match view.mark[other as usize] {
-                0 => overlap(&old, b),
-                m if other < c.id => overlap(&old, &changes[m as usize - 1].old()),
-                _ => return,
-            };
-            if !was {
-                begun.push((c.id.min(other), c.id.max(other)));
-            }
-        });
+        let was = match view.mark[other as usize] {
+            0 => overlap(old, b),
+            m if other < c.id => overlap(old, &changes[m as usize - 1].old()),
+            _ => return,
+        };
+        if !was {
+            begun.push((c.id.min(other), c.id.max(other)));
+        }
+    };
+    let mut group = Group::new();
+    for (c, new) in in_order(changes, order, view) {
+        if new.min.x <= new.max.x && group.push(c, new, c.old()) {
+            group.query(view, stack, &mut hit);
+        }
     }
+    group.query(view, stack, &mut hit);
 }
 
 /// The ended pairs: each changed proxy's old box against the tree for the unchanged
@@ -857,23 +900,28 @@ fn search_ended(
     changes: &[Change],
     order: &[u64],
     view: &View<'_>,
-    stack: &mut Vec<u32>,
+    stack: &mut Vec<u64>,
     ended: &mut Vec<(u32, u32)>,
 ) {
     // The changed proxies that had a box: id, old box, new box.
     let mut olds: Vec<(u32, Aabb3, Aabb3)> = Vec::new();
+    let mut hit = |c: &Change, new: &Aabb3, other: u32, b: &Aabb3| {
+        if view.mark[other as usize] == 0 && !overlap(new, b) {
+            ended.push((c.id.min(other), c.id.max(other)));
+        }
+    };
+    let mut group = Group::new();
     for (c, new) in in_order(changes, order, view) {
         let old = c.old();
         if old.min.x > old.max.x {
             continue;
         }
         olds.push((c.id, old, new));
-        view.query(&old, stack, |other, b| {
-            if view.mark[other as usize] == 0 && !overlap(&new, b) {
-                ended.push((c.id.min(other), c.id.max(other)));
-            }
-        });
+        if group.push(c, old, new) {
+            group.query(view, stack, &mut hit);
+        }
     }
+    group.query(view, stack, &mut hit);
     olds.sort_unstable_by(|a, b| a.1.min.x.total_cmp(&b.1.min.x));
     for (k, a) in olds.iter().enumerate() {
         for b in &olds[k + 1..] {
