@@ -4,7 +4,7 @@
 use super::PoseSource;
 use super::{AosLayouts, Batch, checked_len};
 use crate::aabb::Aabb3;
-use crate::engine::{Active, All, AosPoses, AosRun, ClassJob, Engine, Store, takes_aos};
+use crate::engine::{Active, AosPoses, AosRun, ClassJob, Engine, Store, takes_aos};
 use crate::error::BatchError;
 use crate::layout::{BoxSink, BoxSource, Maps};
 use crate::transform::Transform3;
@@ -94,11 +94,11 @@ impl Batch {
                     let run = AosRun {
                         local,
                         sink: out,
-                        active: All,
+                        active: Active::All,
                         method: batch.method,
                         rounding: batch.rounding,
                     };
-                    return run.run(maps, batch.backend);
+                    return run.run_every(maps, batch.backend);
                 }
                 let len = local.len();
                 match maps {

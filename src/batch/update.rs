@@ -375,7 +375,7 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         stands: L,
-        redo: &impl Redo<N>,
+        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) {
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
         let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
@@ -426,7 +426,7 @@ impl<F> Fat<'_, F> {
         [outside, stands]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
-        redo: &impl Redo<N>,
+        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) where
         F: WriteBoxes<N>,
     {

@@ -182,25 +182,53 @@ impl<'p, T> PoseList<'p, T> for Shared<'p, T> {
 }
 
 /// A run of the AoS loop, its lengths and its active set checked: everything but the
-/// poses, which the pose source adds ([`AosRun::with`]).
-pub(crate) struct AosRun<'a, S, A> {
+/// poses.
+pub(crate) struct AosRun<'a, S> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// Where the tight boxes go.
     pub sink: S,
-    /// The objects visited: [`All`] or an [`Active`] set.
-    pub active: A,
+    /// The objects visited.
+    pub active: Active<'a>,
     /// The method.
     pub method: Method,
     /// The rounding.
     pub rounding: Rounding,
 }
 
-impl<S: AosSink, A: AosActive> AosRun<'_, S, A> {
-    /// Runs over the active objects with `maps`, on a backend that [`takes_aos`].
+impl<S: AosSink> AosRun<'_, S> {
+    /// Runs over every object with `maps`, on a backend that [`takes_aos`]: a batch
+    /// transform, which compiles only this walk.
+    #[inline(always)]
+    pub fn run_every<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
+        debug_assert!(matches!(self.active, Active::All));
+        simd::dispatch_groups(backend, Every { run: self, maps });
+    }
+
+    /// Runs over the active objects with `maps`, on a backend that [`takes_aos`]. Each walk
+    /// is a job of its own, so that its loop has the dispatch wrapper's registers to
+    /// itself: compiled beside the scattered walks, the loop over every object kept the
+    /// output pointer on the stack.
     #[inline(always)]
     pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
-        A::walk(self, maps, backend);
+        match self.active {
+            Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
+            // A list runs one object at a time, in no group: compiled once, for the baseline.
+            Active::Indices(ix) => Listed {
+                run: self,
+                maps,
+                ix,
+            }
+            .run::<1, Vec3A>(),
+            Active::Mask(words) => simd::dispatch_groups(
+                backend,
+                Masked {
+                    run: self,
+                    maps,
+                    words,
+                },
+            ),
+        }
     }
 }
 
@@ -304,59 +332,13 @@ macro_rules! each_kernel {
     }};
 }
 
-/// The objects an AoS run visits, as a type, so that a run compiles only the walks it
-/// can take: [`All`] (a batch transform, the one loop over every object) or an update's
-/// [`Active`] set (that loop, an index list's and a mask's).
-pub(crate) trait AosActive: Copy {
-    /// Runs `run` with `maps` over these objects on `backend`.
-    fn walk<T: Transform3, S: AosSink>(
-        run: AosRun<'_, S, Self>,
-        maps: Maps<'_, T>,
-        backend: Backend,
-    );
-}
-
-/// Every object, known when the run is compiled.
-#[derive(Clone, Copy)]
-pub(crate) struct All;
-
-impl AosActive for All {
-    #[inline(always)]
-    fn walk<T: Transform3, S: AosSink>(
-        run: AosRun<'_, S, Self>,
-        maps: Maps<'_, T>,
-        backend: Backend,
-    ) {
-        simd::dispatch_groups(backend, Every { run, maps });
-    }
-}
-
-impl AosActive for Active<'_> {
-    /// Each walk is a job of its own, so that its loop has the dispatch wrapper's registers
-    /// to itself: compiled beside the scattered walks, the loop over every object kept the
-    /// output pointer on the stack.
-    #[inline(always)]
-    fn walk<T: Transform3, S: AosSink>(
-        run: AosRun<'_, S, Self>,
-        maps: Maps<'_, T>,
-        backend: Backend,
-    ) {
-        match run.active {
-            Active::All => simd::dispatch_groups(backend, Every { run, maps }),
-            // A list runs one object at a time, in no group: compiled once, for the baseline.
-            Active::Indices(ix) => Listed { run, maps, ix }.run::<1, Vec3A>(),
-            Active::Mask(words) => simd::dispatch_groups(backend, Masked { run, maps, words }),
-        }
-    }
-}
-
-/// Every object: the AoS loop's job for [`All`] and [`Active::All`].
-struct Every<'a, 'm, S, A, T> {
-    run: AosRun<'a, S, A>,
+/// Every object.
+struct Every<'a, 'm, S, T> {
+    run: AosRun<'a, S>,
     maps: Maps<'m, T>,
 }
 
-impl<S: AosSink, A, T: Transform3> GroupJob for Every<'_, '_, S, A, T> {
+impl<S: AosSink, T: Transform3> GroupJob for Every<'_, '_, S, T> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
         each_kernel!(self.run, self.maps, W, P, whole);
@@ -365,7 +347,7 @@ impl<S: AosSink, A, T: Transform3> GroupJob for Every<'_, '_, S, A, T> {
 
 /// The objects of an index list.
 struct Listed<'a, 'm, S, T> {
-    run: AosRun<'a, S, Active<'a>>,
+    run: AosRun<'a, S>,
     maps: Maps<'m, T>,
     ix: &'a [u32],
 }
@@ -379,7 +361,7 @@ impl<S: AosSink, T: Transform3> GroupJob for Listed<'_, '_, S, T> {
 
 /// The objects of a mask.
 struct Masked<'a, 'm, S, T> {
-    run: AosRun<'a, S, Active<'a>>,
+    run: AosRun<'a, S>,
     maps: Maps<'m, T>,
     words: &'a [u64],
 }
@@ -393,8 +375,8 @@ impl<S: AosSink, T: Transform3> GroupJob for Masked<'_, '_, S, T> {
 
 /// [`Every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, S: AosSink, A, const W: usize, P: BoxGroup<W>>(
-    run: AosRun<'_, S, A>,
+fn whole<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
+    run: AosRun<'_, S>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
 ) {
@@ -422,7 +404,7 @@ fn request<'p, T: 'p, S: AosSink>(
 /// Xeon). Their memory is requested ahead, one object further as each runs.
 #[inline(always)]
 fn list<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
-    run: AosRun<'_, S, Active<'_>>,
+    run: AosRun<'_, S>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
     ix: &[u32],
@@ -449,7 +431,7 @@ fn list<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
 /// each runs.
 #[inline(always)]
 fn mask<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
-    run: AosRun<'_, S, Active<'_>>,
+    run: AosRun<'_, S>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
     words: &[u64],

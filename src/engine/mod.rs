@@ -49,7 +49,7 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{All, AosPoses, AosRun, AosSink, ClassJob, PoseList, Tight, takes_aos};
+pub(crate) use aos::{AosPoses, AosRun, AosSink, ClassJob, PoseList, Tight, takes_aos};
 
 use active::{List, Mask, Subset};
 
@@ -154,28 +154,27 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     }
 }
 
-/// The tight box of one object on the extended path, for a lane that does not stand.
-pub(crate) trait Redo<const N: usize> {
-    /// Object `i`'s tight box `[min, max]`.
-    fn tight(&self, i: usize) -> [[f32; N]; 2];
-}
-
-/// [`Redo`] from the run's sources, which it hands by value to an out-of-line function.
-/// The loop must never take the address of its trimmed sources: their lengths would then
-/// stay in memory and every column's bound be checked on every span (as happened when the
-/// cold path called a closure that borrowed them); and the cold path's addressing must
-/// stay out of the loop (inlined, it made LLVM keep a pointer per column, in stack slots
-/// updated on every span).
-struct Extended<'r, B, P> {
+/// The tight box of one object on the extended path, for a lane that does not stand: from
+/// the run's sources, which it hands by value to an out-of-line function. The loop must
+/// never take the address of its trimmed sources: their lengths would then stay in memory
+/// and every column's bound be checked on every span (as happened when the cold path called
+/// a closure that borrowed them); and the cold path's addressing must stay out of the loop
+/// (inlined, it made LLVM keep a pointer per column, in stack slots updated on every span).
+pub(crate) struct Redo<'r, B, P> {
     local: &'r B,
     poses: &'r P,
     method: Method,
     rounding: Rounding,
 }
 
-impl<const N: usize, B: ReadBoxes<N> + Clone, P: Poses<N> + Clone> Redo<N> for Extended<'_, B, P> {
+impl<B: Clone, P: Clone> Redo<'_, B, P> {
+    /// Object `i`'s tight box `[min, max]`.
     #[inline(always)]
-    fn tight(&self, i: usize) -> [[f32; N]; 2] {
+    pub(crate) fn tight<const N: usize>(&self, i: usize) -> [[f32; N]; 2]
+    where
+        B: ReadBoxes<N>,
+        P: Poses<N>,
+    {
         tight_one(
             self.local.clone(),
             self.poses.clone(),
@@ -211,7 +210,7 @@ pub(crate) trait Sink<const N: usize> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         stands: L,
-        redo: &impl Redo<N>,
+        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     );
     /// Asks for object `i`'s output ahead of a scattered access.
     #[inline(always)]
@@ -246,7 +245,7 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         lanes: u64,
         [min, max]: [Vector<L, N>; 2],
         stands: L,
-        redo: &impl Redo<N>,
+        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) {
         // Every object is active: a store writes whole spans.
         debug_assert_eq!(lanes.count_ones() as usize, count);
@@ -528,7 +527,7 @@ where
     ) {
         let (lo, hi) = self.local.load::<L>(i, count);
         let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
-        let redo = Extended {
+        let redo = Redo {
             local: &self.local,
             poses: &self.poses,
             method,

@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
-use super::{Class, Named3, Simd3, Transform2, Transform3};
+use super::{Class, Named3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::AffineLanes;
@@ -58,7 +58,7 @@ impl Class<3> for Affine3A {
     }
 }
 
-impl Simd3 for Affine3A {
+impl Transform3 for Affine3A {
     type Simd = AffineLanes<Vec3A, 3>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
@@ -69,8 +69,6 @@ impl Simd3 for Affine3A {
         }
     }
 }
-
-impl Transform3 for Affine3A {}
 
 /// Fields `[m00, m10, m01, m11, t0, t1]`.
 impl Fields for Affine2 {

@@ -10,9 +10,10 @@ pub use quat::{Rigid3, Similarity3, Trs3};
 pub use rigid2::Rigid2;
 pub use translation::{Translation2, Translation3};
 
+use crate::kernel::JoinLanes;
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Named3, Simd3};
+pub(crate) use sealed::{Class, Named3};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -64,13 +65,21 @@ pub(crate) use sealed::{Class, Named3, Simd3};
 /// result is the NaN box, as for a non-finite matrix. A zero quaternion is the identity
 /// rotation of the formula (`R(0) = I`), and a quaternion far from unit length is the
 /// linear map the formula gives; both are bounded like any other.
-pub trait Transform3: Simd3 {
+pub trait Transform3: Class<3> {
     /// The order `n` of this class's Nearest bound `γ(n)·S + τ·TINY_ERROR` under `method`
     /// (see [`Transform3`]); the Outward pad is `(n + 2)·u·S + τ·TINY_PAD`.
     #[must_use]
     fn nearest_order(method: Method) -> u32 {
         <Self as Class<3>>::order(method)
     }
+
+    /// The class on glam's SIMD `Vec3A`, whose lanes are the axes of one box (sealed
+    /// machinery, as [`Class`]'s).
+    #[doc(hidden)]
+    type Simd: JoinLanes;
+    /// The pose as `Vec3A` lanes.
+    #[doc(hidden)]
+    fn simd(&self) -> Self::Simd;
 }
 
 /// A 2D transform class: [`Translation2`], [`Rigid2`] and `glam::Affine2`.
@@ -89,7 +98,7 @@ pub(crate) mod sealed {
     use super::*;
     use crate::extended::ExtendedMap;
     use crate::fields::{Fields, MAX_FIELDS};
-    use crate::kernel::{JoinLanes, MapKernel};
+    use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
 
     /// Poses of a 3D class by name: how generic code reaches the code bvkit compiles once
@@ -127,13 +136,5 @@ pub(crate) mod sealed {
             let _ = poses;
             None
         }
-    }
-
-    /// A 3D class on glam's SIMD `Vec3A`, whose lanes are the axes of one box.
-    pub trait Simd3: Class<3> {
-        /// The class with `Vec3A` lanes.
-        type Simd: JoinLanes;
-        /// The class as `Vec3A` lanes.
-        fn simd(&self) -> Self::Simd;
     }
 }

@@ -7,7 +7,7 @@
 
 use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
 
-use super::{Class, Named3, Simd3, Transform3};
+use super::{Class, Named3, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::{self, AffineLanes};
@@ -400,30 +400,24 @@ impl Class<3> for Trs3 {
     }
 }
 
-impl Simd3 for Rigid3 {
+impl Transform3 for Rigid3 {
     type Simd = QuatLanes<Vec3A, false>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
         quat_simd(self.rotation, Vec3A::ONE, self.translation)
     }
 }
-
-impl Simd3 for Similarity3 {
+impl Transform3 for Similarity3 {
     type Simd = QuatLanes<Vec3A, true>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
         quat_simd(self.rotation, Vec3A::splat(self.scale), self.translation)
     }
 }
-
-impl Simd3 for Trs3 {
+impl Transform3 for Trs3 {
     type Simd = QuatLanes<Vec3A, true>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
         quat_simd(self.rotation, self.scale, self.translation)
     }
 }
-
-impl Transform3 for Rigid3 {}
-impl Transform3 for Similarity3 {}
-impl Transform3 for Trs3 {}

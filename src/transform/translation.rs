@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
-use super::{Class, Named3, Simd3, Transform2, Transform3};
+use super::{Class, Named3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
@@ -149,15 +149,13 @@ impl Class<3> for Translation3 {
     }
 }
 
-impl Simd3 for Translation3 {
+impl Transform3 for Translation3 {
     type Simd = TranslationLanes<Vec3A>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
         TranslationLanes { t: self.0 }
     }
 }
-
-impl Transform3 for Translation3 {}
 
 /// Fields `[t0, t1]`.
 impl Fields for Translation2 {
