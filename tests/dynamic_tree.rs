@@ -303,6 +303,42 @@ fn begun_pairs_alone_match_the_reference() {
 }
 
 #[test]
+fn a_tower_that_comes_apart_ends_every_pair() {
+    // A stack of 64 boxes along z, each touching the next two (the ended pairs of two
+    // moved bodies are swept along the axis of widest spread, here z). Then the odd ones
+    // slide out, alternately to +x and −x: every pair with an odd box ends, those of two
+    // odd boxes included, and only the even boxes' pairs stay.
+    let tower = |shift: f32| -> Vec<Aabb3> {
+        (0..64)
+            .map(|i| {
+                let x = match i % 4 {
+                    1 => shift,
+                    3 => -shift,
+                    _ => 0.0,
+                };
+                let c = Vec3A::new(x, 0.0, i as f32);
+                Aabb3::new(c - Vec3A::new(0.5, 0.5, 1.0), c + Vec3A::new(0.5, 0.5, 1.0))
+            })
+            .collect()
+    };
+    let member = vec![true; 64];
+    let start = tower(0.0);
+    let mut tree = DynamicTree::from_boxes(&start).unwrap();
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &start, &mut pairs).unwrap();
+    let before = brute_force(&start, &member);
+    assert_eq!(as_set(&pairs.begun), before);
+    let moved: Vec<u32> = (1..64).step_by(2).collect();
+    let next = tower(5.0);
+    tree.update(&moved, &next, &mut pairs).unwrap();
+    let now = brute_force(&next, &member);
+    assert!(now.iter().all(|&(a, b)| a % 2 == 0 && b % 2 == 0));
+    assert!(before.contains(&(1, 3)) && !now.contains(&(1, 3)));
+    assert!(pairs.begun.is_empty());
+    assert_eq!(as_set(&pairs.ended), &before - &now);
+}
+
+#[test]
 fn a_build_fills_its_nodes() {
     // A full tree of eight children per node over n proxies has ⌈n/8⌉ bottom nodes, ⌈n/64⌉
     // above them, and so on up to the root: a build takes no more, whatever the counts

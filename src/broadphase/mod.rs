@@ -922,10 +922,24 @@ fn search_ended(
         }
     }
     group.query(view, stack, &mut hit);
-    olds.sort_unstable_by(|a, b| a.1.min.x.total_cmp(&b.1.min.x));
+    // Swept along the axis where the old boxes spread widest: along another, a stack or
+    // a row of bodies would put every pair in the sweep.
+    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for (_, old, _) in &olds {
+        (lo, hi) = (lo.min(old.min), hi.max(old.max));
+    }
+    let spread = hi - lo;
+    let axis = if spread.x >= spread.y && spread.x >= spread.z {
+        0
+    } else if spread.y >= spread.z {
+        1
+    } else {
+        2
+    };
+    olds.sort_unstable_by(|a, b| a.1.min[axis].total_cmp(&b.1.min[axis]));
     for (k, a) in olds.iter().enumerate() {
         for b in &olds[k + 1..] {
-            if b.1.min.x > a.1.max.x {
+            if b.1.min[axis] > a.1.max[axis] {
                 break;
             }
             if overlap(&a.1, &b.1) && !overlap(&a.2, &b.2) {
