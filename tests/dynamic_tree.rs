@@ -304,10 +304,11 @@ fn begun_pairs_alone_match_the_reference() {
 
 #[test]
 fn a_tower_that_comes_apart_ends_every_pair() {
-    // A stack of 64 boxes along z, each touching the next two (the ended pairs of two
-    // moved bodies are swept along the axis of widest spread, here z). Then the odd ones
-    // slide out, alternately to +x and −x: every pair with an odd box ends, those of two
-    // odd boxes included, and only the even boxes' pairs stay.
+    // A stack of 64 boxes along z, each touching the next two: the scene the ended pairs'
+    // sweep takes its widest axis for (any axis gives the same pairs; this checks them,
+    // not the sweep's cost). Then the odd ones slide out, alternately to +x and −x: every
+    // pair with an odd box ends, those of two moved odd boxes included, and only the even
+    // boxes' pairs stay.
     let tower = |shift: f32| -> Vec<Aabb3> {
         (0..64)
             .map(|i| {

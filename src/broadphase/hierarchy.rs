@@ -352,10 +352,10 @@ impl Hierarchy {
     }
 
     /// Calls `hit(i, id, box)` for every query `qs[i]` and every proxy whose box overlaps
-    /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query`] per box, but
-    /// the queries descend together, so a node that several of them reach is read once.
+    /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query`] per box (in
+    /// another order), but the queries descend together, so a node that several of them reach is read once.
     /// Each stack entry carries the queries that reached it (a node, then a byte of them);
-    /// at most [`WIDTH`] queries.
+    /// at most [`WIDTH`] queries (more would spill into the node's bits: checked).
     #[inline(always)]
     pub(crate) fn query_group(
         &self,
@@ -363,7 +363,10 @@ impl Hierarchy {
         stack: &mut Vec<u64>,
         mut hit: impl FnMut(usize, u32, &Aabb3),
     ) {
-        debug_assert!(qs.len() <= WIDTH);
+        assert!(
+            qs.len() <= WIDTH,
+            "at most {WIDTH} queries descend together"
+        );
         let mut splat = [const { None }; WIDTH];
         for (s, q) in splat.iter_mut().zip(qs) {
             *s = Some(Query::new(q));
@@ -484,8 +487,9 @@ impl Hierarchy {
     /// stays empty). Returns true when the build is done and the unions are set.
     ///
     /// The build splits top-down near the median of the widest spread of centres until every
-    /// node has eight children (see [`Task`]): balanced, so its depth is `⌈log8 n⌉` whatever
-    /// the distribution. Every placed proxy's slot goes to `places`.
+    /// group of a node fits a subtree one level shallower (at most eight groups, see
+    /// [`Task`]): balanced, so it has `⌈log8 n⌉` levels (one for `n <= 8`) whatever the
+    /// distribution. Every placed proxy's slot goes to `places`.
     pub(crate) fn step(
         &mut self,
         mut budget: usize,
@@ -560,12 +564,13 @@ impl Hierarchy {
 /// of a rebuild spread over 32 frames took 4–12 ms each at 1M proxies (AMD EPYC Zen 5).
 const PLACE_WORK: usize = 16;
 
-/// A node of a build being filled: its groups of centres, split until there are eight.
+/// A node of a build being filled: its groups of centres, the largest split until every
+/// group fits one unit (then there are at most eight).
 ///
 /// Each group but one holds a whole number of units, the most proxies a subtree one level
 /// shallower can hold (`8^(⌈log8 n⌉ − 1)` for `n` centres), so that every node of the tree
-/// is full but those on one path per node: at most [`full_tree_nodes`], about `n / 7`, at
-/// depth `⌈log8 n⌉`. (Splits at the plain median left bottom nodes of two or three proxies:
+/// is full but those on one path from the root: at most [`full_tree_nodes`], about `n / 7`,
+/// in `⌈log8 n⌉` levels. (Splits at the plain median left bottom nodes of two or three proxies:
 /// 37,449 nodes for 100K proxies, against 14,288 now.)
 #[derive(Clone, Copy, Debug)]
 struct Task {
@@ -580,7 +585,7 @@ impl Task {
         let mut groups = [(0, 0); WIDTH];
         groups[0] = (start as u32, end as u32);
         let mut unit = 1;
-        while unit * WIDTH < end - start {
+        while unit < (end - start).div_ceil(WIDTH) {
             unit *= WIDTH;
         }
         Self {
@@ -640,14 +645,19 @@ fn split_at_median(centres: &mut [Centre], mid: usize) {
             hi[a] = hi[a].max(c.0[a]);
         }
     }
-    // The spreads in `f64`, where they cannot overflow.
+    let axis = widest_axis(lo, hi);
+    centres.select_nth_unstable_by(mid, |a, b| a.0[axis].total_cmp(&b.0[axis]));
+}
+
+/// The axis along which `lo..hi` spreads widest (spreads in `f64`, where they cannot
+/// overflow): what a build splits and the ended pairs' sweep sorts along.
+pub(crate) fn widest_axis(lo: [f32; 3], hi: [f32; 3]) -> usize {
     let spread = [0, 1, 2].map(|a| f64::from(hi[a]) - f64::from(lo[a]));
-    let axis = if spread[0] >= spread[1] && spread[0] >= spread[2] {
+    if spread[0] >= spread[1] && spread[0] >= spread[2] {
         0
     } else if spread[1] >= spread[2] {
         1
     } else {
         2
-    };
-    centres.select_nth_unstable_by(mid, |a, b| a.0[axis].total_cmp(&b.0[axis]));
+    }
 }

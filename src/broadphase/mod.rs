@@ -161,7 +161,7 @@ impl Pairs {
     }
 
     /// Begun and ended pairs (the ended ones cost a second query per changed proxy and a
-    /// sweep along x over the changed proxies' old boxes).
+    /// sweep over the changed proxies' old boxes, along the axis where they spread widest).
     #[must_use]
     pub fn with_ended() -> Self {
         Self {
@@ -472,8 +472,8 @@ impl DynamicTree {
         true
     }
 
-    /// Rebuilds the tree from its proxies, balanced (median splits of the widest spread of
-    /// centres). Boxes and pairs do not change; queries get faster where moves have left
+    /// Rebuilds the tree from its proxies, balanced (near-median splits of the widest spread
+    /// of centres, every node full but those on one path from the root). Boxes and pairs do not change; queries get faster where moves have left
     /// node boxes loose or mixed distant proxies under one node.
     pub fn rebuild(&mut self) {
         self.begin_rebuild(usize::MAX);
@@ -847,6 +847,9 @@ impl<'c> Group<'c> {
         stack: &mut Vec<u64>,
         mut hit: impl FnMut(&'c Change, &Aabb3, u32, &Aabb3),
     ) {
+        if self.len == 0 {
+            return;
+        }
         let changes = &self.changes;
         view.hierarchy
             .query_group(&self.boxes[..self.len], stack, |i, other, b| {
@@ -928,14 +931,7 @@ fn search_ended(
     for (_, old, _) in &olds {
         (lo, hi) = (lo.min(old.min), hi.max(old.max));
     }
-    let spread = hi - lo;
-    let axis = if spread.x >= spread.y && spread.x >= spread.z {
-        0
-    } else if spread.y >= spread.z {
-        1
-    } else {
-        2
-    };
+    let axis = hierarchy::widest_axis(lo.to_array(), hi.to_array());
     olds.sort_unstable_by(|a, b| a.1.min[axis].total_cmp(&b.1.min[axis]));
     for (k, a) in olds.iter().enumerate() {
         for b in &olds[k + 1..] {
