@@ -353,9 +353,10 @@ impl Hierarchy {
 
     /// Calls `hit(i, id, box)` for every query `qs[i]` and every proxy whose box overlaps
     /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query`] per box (in
-    /// another order), but the queries descend together, so a node that several of them reach is read once.
-    /// Each stack entry carries the queries that reached it (a node, then a byte of them);
-    /// at most [`WIDTH`] queries (more would spill into the node's bits: checked).
+    /// another order), but the queries descend together, so a node that several of them
+    /// reach is read once. Each stack entry carries the queries that reached it (a node,
+    /// then a byte of them); at most [`WIDTH`] queries (more would spill into the node's
+    /// bits: checked).
     #[inline(always)]
     pub(crate) fn query_group(
         &self,

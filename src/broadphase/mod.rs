@@ -473,8 +473,9 @@ impl DynamicTree {
     }
 
     /// Rebuilds the tree from its proxies, balanced (near-median splits of the widest spread
-    /// of centres, every node full but those on one path from the root). Boxes and pairs do not change; queries get faster where moves have left
-    /// node boxes loose or mixed distant proxies under one node.
+    /// of centres, every node full but those on one path from the root). Boxes and pairs do
+    /// not change; queries get faster where moves have left node boxes loose or mixed
+    /// distant proxies under one node.
     pub fn rebuild(&mut self) {
         self.begin_rebuild(usize::MAX);
         self.continue_rebuild();
@@ -609,8 +610,8 @@ impl DynamicTree {
     }
 
     /// Sets over about how many [`DynamicTree::maintain`] calls a rebuild is spread (default
-    /// 32; 1 rebuilds at once, in the call that starts it). Fewer frames give each a larger share of the work; more leave
-    /// the old hierarchy in use longer.
+    /// 32; 1 rebuilds at once, in the call that starts it). Fewer frames give each a larger
+    /// share of the work; more leave the old hierarchy in use longer.
     pub fn set_rebuild_frames(&mut self, frames: u32) {
         self.rebuild_frames = frames.max(1);
     }
@@ -647,8 +648,8 @@ impl DynamicTree {
     /// The tree's half of a frame: the proxies in `moved` (strictly ascending ids, as
     /// [`Moved::indices`](crate::Moved::indices)) take their boxes from `fat` (indexed by id,
     /// in any box layout the batch writes), and each enlarges the boxes above it up to the
-    /// first that already contains it. Moved ids not in the tree are ignored; a refused box parks its
-    /// proxy (module docs). The pairs wait for [`DynamicTree::report`].
+    /// first that already contains it. Moved ids not in the tree are ignored; a refused box
+    /// parks its proxy (module docs). The pairs wait for [`DynamicTree::report`].
     ///
     /// # Errors
     /// [`BroadphaseError::Unsorted`], [`BroadphaseError::MissingBox`] or
