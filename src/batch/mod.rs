@@ -14,8 +14,6 @@ pub use large::{LargePose, LargeRigid3};
 pub use moved::Moved;
 pub use update::{LargeWorld, Swept};
 
-use core::marker::PhantomData;
-
 #[cfg(doc)]
 use crate::aabb::Aabb3;
 use crate::engine::Poses;
@@ -135,15 +133,6 @@ impl Batch {
     }
 }
 
-/// Three layouts as types: boxes `B` in, poses `X`, boxes `O` out.
-pub(crate) struct AosLayouts<const N: usize, B, X, O>(PhantomData<(B, X, O)>);
-
-impl<const N: usize, B: ReadBoxes<N>, X: Poses<N>, O: WriteBoxes<N>> AosLayouts<N, B, X, O> {
-    /// True when they are AoS 3D boxes in and out and AoS or shared poses (of a 3D class,
-    /// then): a constant, so that the branch not taken is not compiled.
-    pub const ALL: bool = B::AABB3S && X::AOS && O::AABB3S;
-}
-
 fn checked_len<const N: usize>(
     local: &impl ReadBoxes<N>,
     poses: &impl Poses<N>,
@@ -227,12 +216,12 @@ mod tests {
 
     /// Layouts whose types say they are AoS 3D boxes with AoS or shared poses.
     fn aos<B: ReadBoxes<3>, X: Poses<3>, O: WriteBoxes<3>>(local: B, xf: X, mut out: O) {
-        assert!(AosLayouts::<3, B, X, O>::ALL);
+        assert!(Engine::<3, B, X, Store<O>>::AOS);
         assert!(local.aabb3s().is_some() && xf.aos().is_some() && out.aabb3s_mut().is_some());
     }
 
-    /// Every layout whose constants send a call to the AoS runs converts to them: the
-    /// `unreachable!` of [`Batch::transform`] and [`Batch::update`] is never reached.
+    /// Every layout whose constants send a run to the AoS loop converts to it: the
+    /// `unreachable!`s of [`Engine::run`] and of the sinks' `run_aos` are never reached.
     #[test]
     fn aos_layouts_always_convert() {
         let local = vec![Aabb3::EMPTY; 3];
@@ -245,7 +234,8 @@ mod tests {
         aos(&local, &Trs3::IDENTITY, &mut out);
         aos(&local, &[Similarity3::IDENTITY; 3][..], &mut out);
         aos(&local, &[Translation3::IDENTITY; 3][..], &mut out);
-        const { assert!(!AosLayouts::<3, &[Block8<Aabb3>], &[Rigid3], &mut [Aabb3]>::ALL) };
+        type Blocks<'a> = Engine<'a, 3, &'a [Block8<Aabb3>], &'a [Rigid3], Store<&'a mut [Aabb3]>>;
+        const { assert!(!Blocks::AOS) };
     }
 
     #[test]

@@ -5,16 +5,12 @@ use super::large::LargePose;
 #[cfg(doc)]
 use super::large::LargeRigid3;
 use super::moved::Moved;
-use super::{AosLayouts, Batch, PoseSource};
+use super::{Batch, PoseSource};
 use crate::aabb::Aabb3;
-use crate::engine::{
-    Active, AosPoses, AosRun, AosSink, ClassJob, Engine, PoseList, Poses, Redo, Sink, Tight,
-    takes_aos,
-};
+use crate::engine::{Active, AosCall, AosSink, Engine, PoseList, Poses, Redo, Sink, Tight};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::lane::Vector;
-use crate::layout::Maps;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, BoxGroup, LaneArray};
@@ -251,115 +247,22 @@ impl Batch {
         }
         active.check(len)?;
         moved.reset(len);
-        self.update_checked(active, local, poses, Fat { fat, margin, moved }, len);
-        Ok(())
-    }
-
-    /// [`Batch::update`], its inputs checked: the layouts pick the loop when the call site
-    /// is compiled, so that AoS 3D layouts compile no lane loop there and call code
-    /// compiled once in bvkit.
-    #[inline(always)]
-    fn update_checked<const N: usize, B: BoxSource<N>, P: PoseSource<N>, F: BoxSink<N>>(
-        &self,
-        active: Active<'_>,
-        local: B,
-        poses: P,
-        sink: Fat<'_, F>,
-        len: usize,
-    ) {
-        if AosLayouts::<N, B, P, F>::ALL {
-            let Fat {
-                mut fat,
-                margin,
-                moved,
-            } = sink;
-            let (Some(local), Some(poses), Some(fat)) =
-                (local.aabb3s(), poses.aos(), fat.aabb3s_mut())
-            else {
-                unreachable!("AoS 3D layouts always convert (a test checks every layout)");
-            };
-            self.update_aos(active, local, poses, AosFat { fat, margin, moved });
-        } else {
-            self.update_lanes(active, local, poses, sink, len);
-        }
-    }
-
-    /// [`Batch::update`] in the lane loop, its inputs checked.
-    #[inline(always)]
-    fn update_lanes<const N: usize, F: WriteBoxes<N>>(
-        &self,
-        active: Active<'_>,
-        local: impl BoxSource<N>,
-        poses: impl PoseSource<N>,
-        sink: Fat<'_, F>,
-        len: usize,
-    ) {
         let engine = Engine {
             local,
             poses,
-            sink,
+            sink: Fat { fat, margin, moved },
             len,
             active,
             method: self.method,
             rounding: self.rounding,
         };
         engine.run(self.backend(), !self.is_deterministic());
-    }
-
-    /// [`Batch::update`] of AoS 3D boxes with AoS or shared poses, its inputs checked:
-    /// compiled here once per class, for every call site.
-    #[inline(never)]
-    fn update_aos(
-        &self,
-        active: Active<'_>,
-        local: &[Aabb3],
-        poses: AosPoses<'_>,
-        sink: AosFat<'_>,
-    ) {
-        /// The update of one class.
-        struct Job<'b, 'f> {
-            batch: &'b Batch,
-            active: Active<'b>,
-            local: &'b [Aabb3],
-            sink: AosFat<'f>,
-        }
-        impl<'a> ClassJob<'a> for Job<'_, '_> {
-            fn run<T: Transform3>(self, maps: Maps<'a, T>) {
-                let Job {
-                    batch,
-                    active,
-                    local,
-                    sink,
-                } = self;
-                if takes_aos(batch.backend()) {
-                    let run = AosRun {
-                        local,
-                        sink,
-                        active,
-                        method: batch.method,
-                        rounding: batch.rounding,
-                    };
-                    return run.run(maps, batch.backend());
-                }
-                let AosFat { fat, margin, moved } = sink;
-                let (len, fat) = (local.len(), Fat { fat, margin, moved });
-                match maps {
-                    Maps::Each(poses) => batch.update_lanes(active, local, poses, fat, len),
-                    Maps::Shared(pose) => batch.update_lanes(active, local, pose, fat, len),
-                }
-            }
-        }
-        poses.run(Job {
-            batch: self,
-            active,
-            local,
-            sink,
-        });
+        Ok(())
     }
 }
 
-/// The update's sink in lanes: each tight box compared with its fat box, the fat boxes it
-/// left rewritten, and their objects recorded.
+/// The update's sink: each tight box compared with its fat box, the fat boxes it left
+/// rewritten, and their objects recorded.
 struct Fat<'a, F> {
     fat: F,
     margin: Margin,
@@ -398,6 +301,13 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
         self.fat.read().prefetch(i);
     }
     const AABB3S: bool = F::AABB3S;
+    fn run_aos(mut self, call: AosCall<'_>) {
+        let Some(fat) = self.fat.aabb3s_mut() else {
+            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        };
+        let (margin, moved) = (self.margin, self.moved);
+        fat_aos(call, Fat { fat, margin, moved });
+    }
     type Trimmed = Fat<'a, F::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Self::Trimmed {
@@ -497,14 +407,14 @@ impl<F> Fat<'_, F> {
     }
 }
 
-/// The update's sink on the AoS loop: the fat boxes as AoS 3D boxes.
-struct AosFat<'a> {
-    fat: &'a mut [Aabb3],
-    margin: Margin,
-    moved: &'a mut Moved,
+/// [`Sink::run_aos`] of the fat sink: compiled here, once.
+#[inline(never)]
+fn fat_aos(call: AosCall<'_>, sink: Fat<'_, &mut [Aabb3]>) {
+    call.run(sink);
 }
 
-impl AosSink for AosFat<'_> {
+/// The fat sink on the AoS loop.
+impl AosSink for Fat<'_, &mut [Aabb3]> {
     /// Eight objects at a time: the tight boxes and the mask of those that left their fat
     /// boxes, then a loop over its set bits. A branch per object would mispredict on every
     /// object a walk moves at random; the loop mispredicts once per eight.
@@ -539,10 +449,6 @@ impl AosSink for AosFat<'_> {
             self.fat[i] = tight.fattened(self.margin);
             self.moved.record(i, 1);
         }
-    }
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        simd::prefetch(&self.fat[i]);
     }
 }
 

@@ -12,8 +12,8 @@ use core::marker::PhantomData;
 
 use glam::Vec3A;
 
-use super::Active;
 use super::active::{List, Mask, Subset, Width};
+use super::{Active, Engine, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::layout::Maps;
@@ -24,8 +24,9 @@ use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translati
 /// The objects of one step of a mask's walk: a mask word's worth.
 const SPAN: usize = 64;
 
-/// Where the AoS loop's tight boxes go.
-pub(crate) trait AosSink {
+/// A sink the AoS loop can write: the lane loop's sink over AoS 3D boxes, which also takes
+/// their tight boxes from the single-box kernel ([`Tight`]), several at a time or one.
+pub(crate) trait AosSink: Sink<3> {
     /// Objects `start..start + local.len()`, every one active: object `start + k`'s tight
     /// box is `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
     fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
@@ -37,12 +38,10 @@ pub(crate) trait AosSink {
     );
     /// Object `i` alone, with its tight box.
     fn one(&mut self, i: usize, tight: Aabb3);
-    /// Asks for object `i`'s output ahead of a scattered access.
-    fn prefetch(&self, i: usize);
 }
 
-/// The plain AoS sink: every tight box written.
-impl AosSink for &mut [Aabb3] {
+/// The plain sink on the AoS loop: every tight box written.
+impl AosSink for Store<&mut [Aabb3]> {
     #[inline(always)]
     fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
@@ -51,15 +50,16 @@ impl AosSink for &mut [Aabb3] {
         poses: impl PoseList<'p, T>,
         tight: Tight<P, W>,
     ) {
-        tight.boxes(local, poses, start, &mut self[start..start + local.len()]);
+        tight.boxes(
+            local,
+            poses,
+            start,
+            &mut self.out[start..start + local.len()],
+        );
     }
     #[inline(always)]
     fn one(&mut self, i: usize, tight: Aabb3) {
-        self[i] = tight;
-    }
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        simd::prefetch(&self[i]);
+        self.out[i] = tight;
     }
 }
 
@@ -197,20 +197,17 @@ pub(crate) struct AosRun<'a, S> {
 }
 
 impl<S: AosSink> AosRun<'_, S> {
-    /// Runs over every object with `maps`, on a backend that [`takes_aos`]: a batch
-    /// transform, which compiles only this walk.
-    #[inline(always)]
-    pub fn run_every<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
-        debug_assert!(matches!(self.active, Active::All));
-        simd::dispatch_groups(backend, Every { run: self, maps });
-    }
-
     /// Runs over the active objects with `maps`, on a backend that [`takes_aos`]. Each walk
     /// is a job of its own, so that its loop has the dispatch wrapper's registers to
     /// itself: compiled beside the scattered walks, the loop over every object kept the
-    /// output pointer on the stack.
+    /// output pointer on the stack. A sink that takes every object ([`Sink::EVERY`])
+    /// compiles only that walk.
     #[inline(always)]
     pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
+        if S::EVERY {
+            debug_assert_eq!(self.active, Active::All);
+            return simd::dispatch_groups(backend, Every { run: self, maps });
+        }
         match self.active {
             Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
             // A list runs one object at a time, in no group: compiled once, for the baseline.
@@ -240,17 +237,11 @@ pub(crate) fn takes_aos(backend: Backend) -> bool {
 }
 
 /// AoS or shared poses of a 3D class, by name: what a generic call site hands to the AoS
-/// runs that bvkit compiles once per class ([`ClassJob`]).
+/// runs that bvkit compiles once per class ([`AosCall`]).
 #[derive(Clone, Copy)]
 pub(crate) struct AosPoses<'a> {
     poses: Named3<'a>,
     shared: bool,
-}
-
-/// A job over the poses of any 3D class, run by [`AosPoses::run`] with the class's type.
-pub(crate) trait ClassJob<'a> {
-    /// Runs the job with poses of class `T`.
-    fn run<T: Transform3>(self, maps: Maps<'a, T>);
 }
 
 impl<'a> AosPoses<'a> {
@@ -284,22 +275,91 @@ impl<'a> AosPoses<'a> {
         };
         Some(AosPoses { poses, ..self })
     }
+}
 
-    /// Runs `job` with the poses in their class's type.
-    pub fn run(self, job: impl ClassJob<'a>) {
+/// A run of the engine over AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), with
+/// the poses by name: what the engine hands to its sink ([`Sink::run_aos`]), so that the
+/// run is compiled once in bvkit for each sink, not at every call site.
+pub(crate) struct AosCall<'a> {
+    /// The local boxes.
+    pub local: &'a [Aabb3],
+    /// The poses.
+    pub poses: AosPoses<'a>,
+    /// The objects visited.
+    pub active: Active<'a>,
+    /// The method.
+    pub method: Method,
+    /// The rounding.
+    pub rounding: Rounding,
+    /// The backend.
+    pub backend: Backend,
+}
+
+impl AosCall<'_> {
+    /// Runs into `sink`, with the poses in their class's type: the AoS loop, or on the
+    /// scalar backend the lane loop. Each sink calls it from one non-generic function of
+    /// its own, so that this code is compiled once, in bvkit, for the five classes.
+    #[inline(always)]
+    pub fn run<S: AosSink>(self, sink: S) {
         fn maps<T>(poses: &[T], shared: bool) -> Maps<'_, T> {
             match (shared, poses) {
                 (true, [pose]) => Maps::Shared(pose),
                 _ => Maps::Each(poses),
             }
         }
-        let shared = self.shared;
-        match self.poses {
-            Named3::Translation3(p) => job.run::<Translation3>(maps(p, shared)),
-            Named3::Rigid3(p) => job.run::<Rigid3>(maps(p, shared)),
-            Named3::Similarity3(p) => job.run::<Similarity3>(maps(p, shared)),
-            Named3::Trs3(p) => job.run::<Trs3>(maps(p, shared)),
-            Named3::Affine3A(p) => job.run::<glam::Affine3A>(maps(p, shared)),
+        let shared = self.poses.shared;
+        match self.poses.poses {
+            Named3::Translation3(p) => self.class::<Translation3, S>(maps(p, shared), sink),
+            Named3::Rigid3(p) => self.class::<Rigid3, S>(maps(p, shared), sink),
+            Named3::Similarity3(p) => self.class::<Similarity3, S>(maps(p, shared), sink),
+            Named3::Trs3(p) => self.class::<Trs3, S>(maps(p, shared), sink),
+            Named3::Affine3A(p) => self.class::<glam::Affine3A, S>(maps(p, shared), sink),
+        }
+    }
+
+    /// [`AosCall::run`] with poses of class `T`.
+    #[inline(always)]
+    fn class<T: Transform3, S: AosSink>(self, maps: Maps<'_, T>, sink: S) {
+        let AosCall {
+            local,
+            active,
+            method,
+            rounding,
+            backend,
+            ..
+        } = self;
+        if takes_aos(backend) {
+            let run = AosRun {
+                local,
+                sink,
+                active,
+                method,
+                rounding,
+            };
+            return run.run(maps, backend);
+        }
+        let len = local.len();
+        match maps {
+            Maps::Each(poses) => Engine {
+                local,
+                poses,
+                sink,
+                len,
+                active,
+                method,
+                rounding,
+            }
+            .run_lanes(backend, false),
+            Maps::Shared(pose) => Engine {
+                local,
+                poses: pose,
+                sink,
+                len,
+                active,
+                method,
+                rounding,
+            }
+            .run_lanes(backend, false),
         }
     }
 }

@@ -6,10 +6,11 @@
 //! sink compares it with the fat box and records what moved. Two loops do this:
 //! - [`Engine`], in lanes, for every layout; lanes whose result does not stand are redone
 //!   one at a time on the extended path, and the sink takes those too;
-//! - [`AosRun`], for AoS 3D boxes with AoS or shared poses, on the single-box kernel
-//!   (glam's `Vec3A`), on the backends that [`takes_aos`]. The batch transform and the
-//!   update hand those layouts to code compiled here once per class ([`AosPoses`]), which
-//!   runs this loop or the lane loop.
+//! - the AoS loop, for AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), on the
+//!   single-box kernel (glam's `Vec3A`), on every backend but the scalar one. [`Engine::run`]
+//!   hands those layouts, the poses by name ([`AosPoses`]), to its sink
+//!   ([`Sink::run_aos`]), which runs them in code compiled here once ([`AosCall::run`]):
+//!   the AoS loop, or on the scalar backend the lane loop.
 
 /// `$body` once per method (and per rounding), with `$m` (and `$r`) bound to it as a
 /// constant, so that each copy is specialised to its kernel: the one place the
@@ -49,10 +50,11 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{AosPoses, AosRun, AosSink, ClassJob, PoseList, Tight, takes_aos};
+pub(crate) use aos::{AosCall, AosPoses, AosSink, PoseList, Tight};
 
 use active::{List, Mask, Subset};
 
+use crate::aabb::Aabb3;
 use crate::error::BatchError;
 use crate::extended;
 use crate::kernel;
@@ -219,8 +221,15 @@ pub(crate) trait Sink<const N: usize> {
     }
     /// After the last span (a fence after streaming stores).
     fn finish(&mut self) {}
-    /// True when the sink writes AoS 3D boxes (which the AoS loop can take instead).
+    /// True when the sink takes every object ([`Active::All`]), as a batch transform's
+    /// does: its runs then compile only that walk (a third of the loops otherwise).
+    const EVERY: bool = false;
+    /// True when the sink writes AoS 3D boxes, and [`Sink::run_aos`] takes them.
     const AABB3S: bool = false;
+    /// The run `call` into this sink, where it writes AoS 3D boxes ([`Sink::AABB3S`]): a
+    /// call to a non-generic function of the sink's that runs [`AosCall::run`], so that a
+    /// generic call site compiles none of it.
+    fn run_aos(self, call: AosCall<'_>);
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
@@ -275,7 +284,20 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
             simd::store_fence();
         }
     }
+    const EVERY: bool = true;
     const AABB3S: bool = O::AABB3S;
+    fn run_aos(mut self, call: AosCall<'_>) {
+        let Some(out) = self.out.aabb3s_mut() else {
+            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        };
+        store_aos(
+            call,
+            Store {
+                out,
+                stream: self.stream,
+            },
+        );
+    }
     type Trimmed = Store<O::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Store<O::Trimmed> {
@@ -284,6 +306,12 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
             stream: self.stream,
         }
     }
+}
+
+/// [`Sink::run_aos`] of the plain sink: compiled here, once.
+#[inline(never)]
+fn store_aos(call: AosCall<'_>, sink: Store<&mut [Aabb3]>) {
+    call.run(sink);
 }
 
 /// One run of the engine, its lengths and its active set checked.
@@ -305,13 +333,49 @@ pub(crate) struct Engine<'a, const N: usize, B, P, S> {
 }
 
 impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
+    /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): AoS 3D boxes with AoS
+    /// or shared poses ([`Self::AOS`]) in code compiled once in bvkit, which runs the AoS
+    /// loop or, on the scalar backend, the lane loop; every other layout in the lane loop,
+    /// compiled here.
+    #[inline(always)]
+    pub fn run(self, backend: Backend, fused: bool) {
+        if !Self::AOS {
+            return self.run_lanes(backend, fused);
+        }
+        let Engine {
+            local,
+            poses,
+            sink,
+            active,
+            method,
+            rounding,
+            ..
+        } = self;
+        let (Some(local), Some(poses)) = (local.aabb3s(), poses.aos()) else {
+            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        };
+        sink.run_aos(AosCall {
+            local,
+            poses,
+            active,
+            method,
+            rounding,
+            backend,
+        });
+    }
+
     /// Runs in lanes on `backend` (`fused` lets the lanes fuse multiply-adds).
     ///
     /// The active set picks the loop before the dispatch, so that each job holds only
     /// what its loop reads: compiled beside the scattered walk, whose closures borrow the
-    /// whole run, the plain loop reloaded the layouts' pointers on every span.
+    /// whole run, the plain loop reloaded the layouts' pointers on every span. A sink that
+    /// takes every object ([`Sink::EVERY`]) compiles only that loop.
     #[inline(always)]
-    pub fn run(self, backend: Backend, fused: bool) {
+    pub fn run_lanes(self, backend: Backend, fused: bool) {
+        if S::EVERY {
+            debug_assert_eq!(self.active, Active::All);
+            return Self::dispatch(backend, fused, Every(self.split().1));
+        }
         match self.split() {
             (Active::All, run) => Self::dispatch(backend, fused, Every(run)),
             (Active::Indices(ix), run) => {
@@ -329,8 +393,8 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
     }
 
     /// True for AoS 3D boxes in and out with AoS or shared poses, which the lane loop runs
-    /// only on the scalar backend ([`takes_aos`]).
-    const AOS: bool = B::AABB3S && P::AOS && S::AABB3S;
+    /// only on the scalar backend ([`AosCall::run`]).
+    pub(crate) const AOS: bool = B::AABB3S && P::AOS && S::AABB3S;
 
     /// [`simd::dispatch`], or straight to the scalar reference's lanes where [`Self::AOS`]:
     /// the one backend those layouts take the lane loop on. These runs are compiled once in
@@ -343,15 +407,6 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
         } else {
             simd::dispatch(backend, fused, job);
         }
-    }
-
-    /// [`Engine::run`] where the active set is [`Active::All`] (a batch transform): the
-    /// one job that needs, so that a transform's call site compiles no scattered walk (a
-    /// third of the lane loops that [`Engine::run`] compiles).
-    #[inline(always)]
-    pub fn run_every(self, backend: Backend, fused: bool) {
-        debug_assert_eq!(self.active, Active::All);
-        Self::dispatch(backend, fused, Every(self.split().1));
     }
 
     /// [`Engine::run`] in lanes of type `L`, without the dispatch.
