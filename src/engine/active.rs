@@ -227,6 +227,47 @@ impl<W: SpanWidth> Iterator for MaskSpans<'_, W> {
     }
 }
 
+/// What the walk of a scattered active set does with its objects ([`walk`]): the lane loop
+/// and the AoS loop each implement it once.
+pub(crate) trait Visit {
+    /// Objects `start..end`, every one active: whole spans that follow each other, whose
+    /// memory is left to the hardware prefetcher.
+    fn whole(&mut self, start: usize, end: usize);
+    /// The active objects of a span that has inactive ones, requested ahead.
+    fn part(&mut self, span: Span);
+    /// Asks for object `i`'s memory ahead of a scattered access.
+    fn request(&self, i: usize);
+}
+
+/// The one walk of a scattered active set, in spans of `W::OBJECTS` objects: whole spans
+/// that follow each other are run together ([`Visit::whole`]), every other span on its own
+/// ([`Visit::part`]) after the lookahead has requested as many objects further.
+#[inline(always)]
+pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl Visit) {
+    let mut ahead = set.lookahead();
+    for i in ahead.requests() {
+        visit.request(i);
+    }
+    let mut spans = set.spans::<W>(len).peekable();
+    while let Some(span) = spans.next() {
+        ahead.enter(span);
+        if span.is_full() {
+            let mut end = span.start + span.count;
+            while let Some(next) = spans.next_if(|s| s.start == end && s.is_full()) {
+                ahead.enter(next);
+                end += next.count;
+            }
+            visit.whole(span.start, end);
+        } else {
+            ahead.advance(span.lanes.count_ones() as usize);
+            for i in ahead.requests() {
+                visit.request(i);
+            }
+            visit.part(span);
+        }
+    }
+}
+
 /// How many scattered objects ahead a run requests memory.
 const AHEAD: usize = 16;
 

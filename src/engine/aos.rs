@@ -12,7 +12,7 @@ use core::marker::PhantomData;
 
 use glam::Vec3A;
 
-use super::active::{List, Mask, Subset, Width};
+use super::active::{self, List, Mask, Span, Subset, Visit, Width};
 use super::{Active, Engine, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
@@ -21,8 +21,8 @@ use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
 use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
-/// The objects of one step of a mask's walk: a mask word's worth.
-const SPAN: usize = 64;
+/// The objects of a span of the scattered walks ([`active::walk`]).
+const SPAN: usize = 8;
 
 /// A sink the AoS loop can write: the lane loop's sink over AoS 3D boxes, which also takes
 /// their tight boxes from the single-box kernel ([`Tight`]), several at a time or one.
@@ -210,19 +210,20 @@ impl<S: AosSink> AosRun<'_, S> {
         }
         match self.active {
             Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
-            // A list runs one object at a time, in no group: compiled once, for the baseline.
-            Active::Indices(ix) => Listed {
+            // A list's objects are scattered: they run in no group, compiled once for the
+            // baseline.
+            Active::Indices(ix) => Scattered {
                 run: self,
                 maps,
-                ix,
+                set: List(ix),
             }
             .run::<1, Vec3A>(),
             Active::Mask(words) => simd::dispatch_groups(
                 backend,
-                Masked {
+                Scattered {
                     run: self,
                     maps,
-                    words,
+                    set: Mask(words),
                 },
             ),
         }
@@ -317,8 +318,8 @@ impl AosCall<'_> {
         }
     }
 
-    /// [`AosCall::run`] with poses of class `T`.
-    #[inline(always)]
+    /// [`AosCall::run`] with poses of class `T`. Not forced inline: in a debug build, the
+    /// five classes' loops inlined into one function took a 1.3 MB stack frame.
     fn class<T: Transform3, S: AosSink>(self, maps: Maps<'_, T>, sink: S) {
         let AosCall {
             local,
@@ -405,31 +406,17 @@ impl<S: AosSink, T: Transform3> GroupJob for Every<'_, '_, S, T> {
     }
 }
 
-/// The objects of an index list.
-struct Listed<'a, 'm, S, T> {
+/// The objects of an index list or a mask: `A`, a [`Subset`] of one kind.
+struct Scattered<'a, 'm, S, T, A> {
     run: AosRun<'a, S>,
     maps: Maps<'m, T>,
-    ix: &'a [u32],
+    set: A,
 }
 
-impl<S: AosSink, T: Transform3> GroupJob for Listed<'_, '_, S, T> {
+impl<S: AosSink, T: Transform3, A: Subset> GroupJob for Scattered<'_, '_, S, T, A> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
-        each_kernel!(self.run, self.maps, W, P, list, self.ix);
-    }
-}
-
-/// The objects of a mask.
-struct Masked<'a, 'm, S, T> {
-    run: AosRun<'a, S>,
-    maps: Maps<'m, T>,
-    words: &'a [u64],
-}
-
-impl<S: AosSink, T: Transform3> GroupJob for Masked<'_, '_, S, T> {
-    #[inline(always)]
-    fn run<const W: usize, P: BoxGroup<W>>(self) {
-        each_kernel!(self.run, self.maps, W, P, mask, self.words);
+        each_kernel!(self.run, self.maps, W, P, scattered, self.set);
     }
 }
 
@@ -446,85 +433,64 @@ fn whole<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
     sink.run(0, local, poses, tight);
 }
 
-/// Asks for object `i`'s local box, pose and output.
+/// The active objects of `set` ([`active::walk`]): runs of whole spans several boxes per
+/// vector, with the validity test per chunk ([`AosSink::run`]), and the objects of other
+/// spans one at a time.
 #[inline(always)]
-fn request<'p, T: 'p, S: AosSink>(
-    local: &[Aabb3],
-    poses: impl PoseList<'p, T>,
-    sink: &S,
-    i: usize,
-) {
-    simd::prefetch(&local[i]);
-    simd::prefetch(poses.at(i));
-    sink.prefetch(i);
-}
-
-/// The objects of a list, one at a time, in its order (building each span's mask from a
-/// list cost more than the objects: 1.4x at 1% and 10% active, measured on an Intel
-/// Xeon). Their memory is requested ahead, one object further as each runs.
-#[inline(always)]
-fn list<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
+fn scattered<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_, S>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
-    ix: &[u32],
+    set: impl Subset,
 ) {
-    let AosRun {
-        local, mut sink, ..
-    } = run;
-    let mut lookahead = List(ix).lookahead();
-    for j in lookahead.requests() {
-        request(local, poses, &sink, j);
-    }
-    for &i in ix {
-        let i = i as usize;
-        lookahead.advance(1);
-        for j in lookahead.requests() {
-            request(local, poses, &sink, j);
-        }
-        sink.one(i, tight.of(&local[i], poses.at(i)));
-    }
+    let AosRun { local, sink, .. } = run;
+    let mut objects = Objects {
+        local,
+        sink,
+        poses,
+        tight,
+        class: PhantomData,
+    };
+    active::walk::<Width<SPAN>>(set, local.len(), &mut objects);
 }
 
-/// The spans of a mask: its whole words that follow each other as one run, and the rest
-/// one at a time. The scattered objects' memory is requested ahead, one object further as
-/// each runs.
-#[inline(always)]
-fn mask<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
-    run: AosRun<'_, S>,
-    poses: impl PoseList<'p, T>,
-    tight: Tight<P, W>,
-    words: &[u64],
-) {
-    let AosRun {
-        local, mut sink, ..
-    } = run;
-    let mut lookahead = Mask(words).lookahead();
-    for j in lookahead.requests() {
-        request(local, poses, &sink, j);
+/// The AoS loop's visit of a scattered active set.
+struct Objects<'a, 'p, S, Q, T, G> {
+    local: &'a [Aabb3],
+    sink: S,
+    poses: Q,
+    tight: G,
+    class: PhantomData<fn() -> &'p T>,
+}
+
+impl<'p, T, S, Q, const W: usize, P> Visit for Objects<'_, 'p, S, Q, T, Tight<P, W>>
+where
+    T: Transform3 + 'p,
+    S: AosSink,
+    Q: PoseList<'p, T>,
+    P: BoxGroup<W>,
+{
+    #[inline(always)]
+    fn whole(&mut self, start: usize, end: usize) {
+        let local = &self.local[start..end];
+        self.sink.run(start, local, self.poses, self.tight);
     }
-    let mut spans = Mask(words).spans::<Width<SPAN>>(local.len()).peekable();
-    while let Some(span) = spans.next() {
-        lookahead.enter(span);
-        if span.is_full() {
-            let mut end = span.start + span.count;
-            while let Some(next) = spans.next_if(|s| s.start == end && s.is_full()) {
-                lookahead.enter(next);
-                end += next.count;
-            }
-            let start = span.start;
-            sink.run(start, &local[start..end], poses, tight);
-            continue;
-        }
+
+    #[inline(always)]
+    fn part(&mut self, span: Span) {
         let mut bits = span.lanes;
         while bits != 0 {
             let i = span.start + bits.trailing_zeros() as usize;
-            lookahead.advance(1);
-            for j in lookahead.requests() {
-                request(local, poses, &sink, j);
-            }
-            sink.one(i, tight.of(&local[i], poses.at(i)));
+            let tight = self.tight.of(&self.local[i], self.poses.at(i));
+            self.sink.one(i, tight);
             bits &= bits - 1;
         }
+    }
+
+    #[inline(always)]
+    fn request(&self, i: usize) {
+        simd::prefetch(&self.local[i]);
+        simd::prefetch(self.poses.at(i));
+        self.sink.prefetch(i);
     }
 }

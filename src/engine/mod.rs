@@ -52,7 +52,8 @@ mod aos;
 pub use active::Active;
 pub(crate) use aos::{AosCall, AosPoses, AosSink, PoseList, Tight};
 
-use active::{List, Mask, Subset};
+use active::{List, Mask, Span, Subset, Visit};
+use core::marker::PhantomData;
 
 use crate::aabb::Aabb3;
 use crate::error::BatchError;
@@ -447,6 +448,51 @@ struct Run<const N: usize, B, P, S> {
     rounding: Rounding,
 }
 
+/// The lane loop's visit of a scattered active set, in spans of the lane width `L`.
+struct Spans<'r, L, R> {
+    run: &'r mut R,
+    method: Method,
+    outward: bool,
+    lanes: PhantomData<L>,
+}
+
+impl<L: LaneArray, const N: usize, B, P, S> Visit for Spans<'_, L, Run<N, B, P, S>>
+where
+    B: ReadBoxes<N> + Clone,
+    P: Poses<N> + Clone,
+    S: Sink<N>,
+{
+    #[inline(always)]
+    fn whole(&mut self, start: usize, end: usize) {
+        self.run.range::<L>(start, end, self.method, self.outward);
+    }
+
+    /// A span with more than one active object runs in lanes (its inactive lanes are
+    /// computed and ignored); a lone active object and the tail run in one lane of the same
+    /// arithmetic.
+    #[inline(always)]
+    fn part(&mut self, span: Span) {
+        let (method, outward) = (self.method, self.outward);
+        if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
+            self.run
+                .lanes::<L>(span.start, L::WIDTH, span.lanes, method, outward);
+        } else {
+            let mut bits = span.lanes;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                self.run
+                    .lanes::<L::One>(span.start + k, 1, 1, method, outward);
+                bits &= bits - 1;
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn request(&self, i: usize) {
+        self.run.prefetch(i);
+    }
+}
+
 /// Every object: the job of [`Active::All`].
 struct Every<const N: usize, B, P, S>(Run<N, B, P, S>);
 
@@ -466,7 +512,8 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, 
     fn run<L: LaneArray>(self) {
         let mut run = self.0.trim();
         let outward = run.rounding == Rounding::Outward;
-        specialise!(run.method, |method| run.every::<L>(method, outward));
+        let len = run.len;
+        specialise!(run.method, |method| run.range::<L>(0, len, method, outward));
         run.sink.finish();
     }
 }
@@ -479,8 +526,15 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
     fn run<L: LaneArray>(self) {
         let (mut run, set) = (self.run.trim(), self.set);
         let outward = run.rounding == Rounding::Outward;
+        let len = run.len;
         specialise!(run.method, |method| {
-            run.spans::<L>(set, method, outward)
+            let mut spans = Spans::<L, _> {
+                run: &mut run,
+                method,
+                outward,
+                lanes: PhantomData,
+            };
+            active::walk::<L>(set, len, &mut spans);
         });
         run.sink.finish();
     }
@@ -510,50 +564,20 @@ where
     P: Poses<N> + Clone,
     S: Sink<N>,
 {
-    /// Every object: a plain loop over whole spans, then the tail one lane at a time.
-    /// Walking spans here measured up to 1.5x slower on cheap kernels in cache (the
-    /// per-span decoding and mask tests are not free there).
+    /// Objects `start..end`, every one active: a plain loop over spans of the lane width,
+    /// then the tail one lane at a time. Over every object, walking spans measured up to
+    /// 1.5x slower on cheap kernels in cache (the per-span decoding and mask tests are not
+    /// free there).
     #[inline(always)]
-    fn every<L: LaneArray>(&mut self, method: Method, outward: bool) {
-        let (w, mut i) = (L::WIDTH, 0);
-        while i + w <= self.len {
+    fn range<L: LaneArray>(&mut self, start: usize, end: usize, method: Method, outward: bool) {
+        let (w, mut i) = (L::WIDTH, start);
+        while i + w <= end {
             self.lanes::<L>(i, w, u64::MAX >> (64 - w), method, outward);
             i += w;
         }
-        while i < self.len {
+        while i < end {
             self.lanes::<L::One>(i, 1, 1, method, outward);
             i += 1;
-        }
-    }
-
-    /// The active objects in aligned spans of the lane width: a span with more than one
-    /// active object runs in lanes (its inactive lanes are computed and ignored), a lone
-    /// active object and the tail run in one lane of the same arithmetic.
-    #[inline(always)]
-    fn spans<L: LaneArray>(&mut self, set: impl Subset, method: Method, outward: bool) {
-        let mut ahead = set.lookahead();
-        for i in ahead.requests() {
-            self.prefetch(i);
-        }
-        for span in set.spans::<L>(self.len) {
-            // A scattered span's objects: as many more requested.
-            ahead.enter(span);
-            if !span.is_full() {
-                ahead.advance(span.lanes.count_ones() as usize);
-                for i in ahead.requests() {
-                    self.prefetch(i);
-                }
-            }
-            if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
-                self.lanes::<L>(span.start, L::WIDTH, span.lanes, method, outward);
-            } else {
-                let mut bits = span.lanes;
-                while bits != 0 {
-                    let k = bits.trailing_zeros() as usize;
-                    self.lanes::<L::One>(span.start + k, 1, 1, method, outward);
-                    bits &= bits - 1;
-                }
-            }
         }
     }
 
