@@ -470,10 +470,19 @@ where
     Q: PoseList<'p, T>,
     P: BoxGroup<W>,
 {
+    /// Several boxes per vector; a list's objects, which run in no group (`W` is 1), one at
+    /// a time, as they would in a group of one.
     #[inline(always)]
     fn whole(&mut self, start: usize, end: usize) {
-        let local = &self.local[start..end];
-        self.sink.run(start, local, self.poses, self.tight);
+        if W == 1 {
+            for i in start..end {
+                let tight = self.tight.of(&self.local[i], self.poses.at(i));
+                self.sink.one(i, tight);
+            }
+        } else {
+            let local = &self.local[start..end];
+            self.sink.run(start, local, self.poses, self.tight);
+        }
     }
 
     #[inline(always)]

@@ -575,7 +575,8 @@ where
             self.lanes::<L>(i, w, u64::MAX >> (64 - w), method, outward);
             i += w;
         }
-        while i < end {
+        // A lane type of one object (the scalar reference's) has no tail.
+        while L::WIDTH > 1 && i < end {
             self.lanes::<L::One>(i, 1, 1, method, outward);
             i += 1;
         }
