@@ -563,7 +563,7 @@ mod tests {
                     }
                     let what = alloc::format!("{backend:?} {active:?} {deterministic}");
                     // The spy hides the AoS slice, so AoS boxes take the lane loop (the AoS
-                    // loop, `AosFat`, visits active objects only).
+                    // loop visits active objects only).
                     let fat = alloc::vec![Aabb3::EMPTY; n];
                     let aos = written(&batch, active, &local[..], &poses[..], fat.clone());
                     assert_eq!(aos, set, "AoS, lane loop {what}");

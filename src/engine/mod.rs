@@ -52,7 +52,7 @@ mod aos;
 pub use active::Active;
 pub(crate) use aos::{AosCall, AosPoses, AosSink, PoseList, Tight};
 
-use active::{List, Mask, Span, Subset, Visit};
+use active::{List, Lookahead, Mask, Span, Subset, Upcoming, Visit};
 use core::marker::PhantomData;
 
 use crate::aabb::Aabb3;
@@ -467,11 +467,15 @@ where
         self.run.range::<L>(start, end, self.method, self.outward);
     }
 
-    /// A span with more than one active object runs in lanes (its inactive lanes are
-    /// computed and ignored); a lone active object and the tail run in one lane of the same
-    /// arithmetic.
+    /// Its objects requested first; then a span with more than one active object runs in
+    /// lanes (its inactive lanes are computed and ignored), a lone active object and the
+    /// tail in one lane of the same arithmetic.
     #[inline(always)]
-    fn part(&mut self, span: Span) {
+    fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
+        ahead.advance(span.lanes.count_ones() as usize);
+        for i in ahead.requests() {
+            self.run.prefetch(i);
+        }
         let (method, outward) = (self.method, self.outward);
         if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
             self.run
