@@ -537,7 +537,7 @@ mod tests {
             0..130 => i % 5 == 1,
             130..300 => true,
             300..320 => i != 311,
-            320..512 => (320..384).contains(&i) || (448..456).contains(&i) || i % 9 == 0,
+            320..512 => (320..384).contains(&i) || (448..456).contains(&i) || i.is_multiple_of(9),
             _ => i % 3 != 0,
         };
         let expected: Vec<usize> = (0..len).filter(|&i| active(i)).collect();
