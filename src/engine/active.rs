@@ -184,6 +184,15 @@ impl<W: SpanWidth> Iterator for ListSpans<'_, W> {
     #[inline(always)]
     fn next(&mut self) -> Option<Span> {
         let first = *self.ix.get(self.at)? as usize;
+        if W::OBJECTS == 1 {
+            // An entry is its span.
+            self.at += 1;
+            return Some(Span {
+                start: first,
+                count: 1,
+                lanes: 1,
+            });
+        }
         let start = first - first % W::OBJECTS;
         let end = start + W::OBJECTS;
         let mut lanes = 0;
@@ -251,12 +260,14 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
     for i in ahead.requests() {
         visit.request(i);
     }
+    if W::OBJECTS == 1 {
+        for span in set.spans::<W>(len) {
+            visit.part(span, &mut ahead);
+        }
+        return;
+    }
     let mut spans = set.spans::<W>(len).peekable();
     while let Some(span) = spans.next() {
-        if W::OBJECTS == 1 {
-            visit.part(span, &mut ahead);
-            continue;
-        }
         ahead.enter(span);
         if span.is_full() {
             let mut end = span.start + span.count;
