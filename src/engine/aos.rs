@@ -13,7 +13,7 @@ use core::marker::PhantomData;
 use glam::Vec3A;
 
 use super::active::{self, List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width};
-use super::{Active, Engine, Sink, Store};
+use super::{Active, Engine, Poses, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::layout::Maps;
@@ -286,6 +286,7 @@ impl<'a> AosPoses<'a> {
 /// A run of the engine over AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), with
 /// the poses by name: what the engine hands to its sink ([`Sink::run_aos`]), so that the
 /// run is compiled once in bvkit for each sink, not at every call site.
+#[derive(Clone, Copy)]
 pub(crate) struct AosCall<'a> {
     /// The local boxes.
     pub local: &'a [Aabb3],
@@ -326,47 +327,34 @@ impl AosCall<'_> {
     /// [`AosCall::run`] with poses of class `T`. Not forced inline: in a debug build, the
     /// five classes' loops inlined into one function took a 1.3 MB stack frame.
     fn class<T: Transform3, S: AosSink>(self, maps: Maps<'_, T>, sink: S) {
-        let AosCall {
-            local,
-            active,
-            method,
-            rounding,
-            backend,
-            ..
-        } = self;
-        if takes_aos(backend) {
+        if takes_aos(self.backend) {
             let run = AosRun {
-                local,
+                local: self.local,
                 sink,
-                active,
-                method,
-                rounding,
+                active: self.active,
+                method: self.method,
+                rounding: self.rounding,
             };
-            return run.run(maps, backend);
+            return run.run(maps, self.backend);
         }
-        let len = local.len();
         match maps {
-            Maps::Each(poses) => Engine {
-                local,
-                poses,
-                sink,
-                len,
-                active,
-                method,
-                rounding,
-            }
-            .run_lanes(backend, false),
-            Maps::Shared(pose) => Engine {
-                local,
-                poses: pose,
-                sink,
-                len,
-                active,
-                method,
-                rounding,
-            }
-            .run_lanes(backend, false),
+            Maps::Each(poses) => self.lanes(poses, sink),
+            Maps::Shared(pose) => self.lanes(pose, sink),
         }
+    }
+
+    /// The lane loop with `poses`, on the scalar backend.
+    fn lanes<P: Poses<3>>(self, poses: P, sink: impl Sink<3>) {
+        let engine = Engine {
+            local: self.local,
+            poses,
+            sink,
+            len: self.local.len(),
+            active: self.active,
+            method: self.method,
+            rounding: self.rounding,
+        };
+        engine.run_lanes(self.backend, false);
     }
 }
 

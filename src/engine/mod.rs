@@ -474,7 +474,7 @@ where
     fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
         ahead.advance(span.lanes.count_ones() as usize);
         for i in ahead.requests() {
-            self.run.prefetch(i);
+            self.request(i);
         }
         let (method, outward) = (self.method, self.outward);
         if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
