@@ -14,7 +14,6 @@
 //! point).
 
 use crate::num::pow2;
-use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::DVec3;
@@ -185,7 +184,14 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
         .collect()
 }
 
+/// No face or point: the end of an outside list, a point on no list.
+const NONE: usize = usize::MAX;
+
 /// The working state: faces with their outside sets and their neighbours.
+///
+/// An outside set is a list threaded through the points (`first`, `last` per face, `next`
+/// per point), in the order the points were assigned; the walks keep their lists in scratch
+/// vectors that live as long as the hull. So a run allocates only as the faces grow.
 struct Quickhull<'a> {
     points: &'a [DVec3],
     faces: Vec<[usize; 3]>,
@@ -193,10 +199,19 @@ struct Quickhull<'a> {
     /// (it runs the other way).
     neighbors: Vec<[usize; 3]>,
     alive: Vec<bool>,
-    outside: Vec<Vec<usize>>,
+    /// The first and last point of each face's outside set ([`NONE`] when it is empty).
+    first: Vec<usize>,
+    last: Vec<usize>,
+    /// The point after each point in its face's outside set.
+    next: Vec<usize>,
     /// `visible[f] == step` marks the faces that the current eye sees.
     visible: Vec<usize>,
     step: usize,
+    /// Scratch: the visible faces in walk order, the horizon, the new faces, the orphans.
+    seen: Vec<usize>,
+    horizon: Vec<(usize, usize, usize)>,
+    cone: Vec<usize>,
+    orphans: Vec<usize>,
 }
 
 impl<'a> Quickhull<'a> {
@@ -215,14 +230,17 @@ impl<'a> Quickhull<'a> {
             faces: Vec::new(),
             neighbors: Vec::new(),
             alive: Vec::new(),
-            outside: Vec::new(),
+            first: Vec::new(),
+            last: Vec::new(),
+            next: vec![NONE; points.len()],
             visible: Vec::new(),
             step: 0,
+            seen: Vec::new(),
+            horizon: Vec::new(),
+            cone: Vec::new(),
+            orphans: Vec::new(),
         };
-        let new_faces: Vec<usize> = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]]
-            .into_iter()
-            .map(|f| hull.add_face(f))
-            .collect();
+        let new_faces = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]].map(|f| hull.add_face(f));
         // Each edge's twin runs the other way in another of the four faces.
         for f in 0..4 {
             for k in 0..3 {
@@ -244,7 +262,8 @@ impl<'a> Quickhull<'a> {
         self.faces.push(face);
         self.neighbors.push([id; 3]);
         self.alive.push(true);
-        self.outside.push(Vec::new());
+        self.first.push(NONE);
+        self.last.push(NONE);
         self.visible.push(0);
         id
     }
@@ -254,42 +273,57 @@ impl<'a> Quickhull<'a> {
         above(a, b, c, self.points[point])
     }
 
-    /// Puts each point into the outside set of the first face that sees it; the others lie
-    /// inside the hull of the faces (Barber et al. 1996, Lemma 3.1) and are dropped.
+    /// The points of a face's outside set, in the order they were assigned.
+    fn outside(&self, face: usize) -> impl Iterator<Item = usize> + '_ {
+        let point = |i: usize| (i != NONE).then_some(i);
+        core::iter::successors(point(self.first[face]), move |&i| point(self.next[i]))
+    }
+
+    /// Puts each point at the end of the outside set of the first face that sees it; the
+    /// others lie inside the hull of the faces (Barber et al. 1996, Lemma 3.1) and are
+    /// dropped.
     fn assign(&mut self, points: impl Iterator<Item = usize>, faces: &[usize]) {
         for i in points {
             if let Some(&f) = faces.iter().find(|&&f| self.sees(f, i)) {
-                self.outside[f].push(i);
+                self.next[i] = NONE;
+                match self.last[f] {
+                    NONE => self.first[f] = i,
+                    tail => self.next[tail] = i,
+                }
+                self.last[f] = i;
             }
         }
     }
 
     /// The point of the face's outside set farthest from its plane (`f64` is enough: any
-    /// point that the face sees is a valid choice).
+    /// point that the face sees is a valid choice); the last of them on ties.
     fn eye(&self, face: usize) -> usize {
         let [a, b, c] = self.faces[face].map(|i| self.points[i]);
         let n = (b - a).cross(c - a);
         let height = |i: usize| (self.points[i] - a).dot(n);
-        let set = &self.outside[face];
-        set.iter()
-            .copied()
+        self.outside(face)
             .max_by(|&i, &j| height(i).total_cmp(&height(j)))
-            .unwrap_or(set[0])
+            .unwrap_or(self.first[face])
     }
 
     /// Adds outside points until no face sees any.
     fn run(&mut self) {
         let mut stack: Vec<usize> = (0..self.faces.len()).collect();
         while let Some(face) = stack.pop() {
-            if !self.alive[face] || self.outside[face].is_empty() {
+            if !self.alive[face] || self.first[face] == NONE {
                 continue;
             }
             let eye = self.eye(face);
-            let visible = self.visible_from(face, eye);
-            // The horizon: edges of visible faces whose neighbour is not visible, with it.
-            let mut horizon = Vec::new();
-            let mut orphans = Vec::new();
-            for &f in &visible {
+            self.visible_from(face, eye);
+            // The horizon: edges of visible faces whose neighbour is not visible, with it;
+            // the orphans: the visible faces' outside points, in order.
+            let mut horizon = core::mem::take(&mut self.horizon);
+            let mut orphans = core::mem::take(&mut self.orphans);
+            let mut cone = core::mem::take(&mut self.cone);
+            horizon.clear();
+            orphans.clear();
+            cone.clear();
+            for &f in &self.seen {
                 let tri = self.faces[f];
                 for k in 0..3 {
                     let g = self.neighbors[f][k];
@@ -298,72 +332,71 @@ impl<'a> Quickhull<'a> {
                     }
                 }
                 self.alive[f] = false;
-                orphans.append(&mut self.outside[f]);
+                orphans.extend(self.outside(f));
             }
             // A cone of new faces `(u, v, eye)`: across `(u, v)` the horizon face, across
             // `(v, eye)` the new face that starts at `v`, across `(eye, u)` the one that ends
             // at `u` (the horizon is one simple cycle).
-            let new_faces: Vec<usize> = horizon
-                .iter()
-                .map(|&(u, v, g)| {
-                    let id = self.add_face([u, v, eye]);
-                    self.neighbors[id][0] = g;
-                    if let Some(j) =
-                        (0..3).find(|&j| self.faces[g][j] == v && self.faces[g][(j + 1) % 3] == u)
-                    {
-                        self.neighbors[g][j] = id;
-                    }
-                    id
-                })
-                .collect();
-            for (n, &(u, v, _)) in horizon.iter().enumerate() {
-                let id = new_faces[n];
-                let starts_at = |x: usize| horizon.iter().position(|&(s, _, _)| s == x);
-                let ends_at = |x: usize| horizon.iter().position(|&(_, e, _)| e == x);
-                if let Some(m) = starts_at(v) {
-                    self.neighbors[id][1] = new_faces[m];
+            for &(u, v, g) in &horizon {
+                let id = self.add_face([u, v, eye]);
+                self.neighbors[id][0] = g;
+                if let Some(j) =
+                    (0..3).find(|&j| self.faces[g][j] == v && self.faces[g][(j + 1) % 3] == u)
+                {
+                    self.neighbors[g][j] = id;
                 }
-                if let Some(m) = ends_at(u) {
-                    self.neighbors[id][2] = new_faces[m];
+                cone.push(id);
+            }
+            for (n, &(u, v, _)) in horizon.iter().enumerate() {
+                let id = cone[n];
+                if let Some(m) = horizon.iter().position(|&(s, _, _)| s == v) {
+                    self.neighbors[id][1] = cone[m];
+                }
+                if let Some(m) = horizon.iter().position(|&(_, e, _)| e == u) {
+                    self.neighbors[id][2] = cone[m];
                 }
             }
-            self.assign(orphans.into_iter().filter(|&i| i != eye), &new_faces);
-            stack.extend(new_faces);
+            self.assign(orphans.iter().copied().filter(|&i| i != eye), &cone);
+            stack.extend(&cone);
+            self.horizon = horizon;
+            self.orphans = orphans;
+            self.cone = cone;
         }
     }
 
-    /// The faces that see `eye`: a connected disk, found by a walk from `start` across
-    /// neighbours, in walk order (so the hull is the same on every run); each is marked
-    /// with a new step number in `visible`.
-    fn visible_from(&mut self, start: usize, eye: usize) -> Vec<usize> {
+    /// The faces that see `eye` into `seen`: a connected disk, found by a walk from `start`
+    /// across neighbours, in walk order (so the hull is the same on every run); each is
+    /// marked with a new step number in `visible`.
+    fn visible_from(&mut self, start: usize, eye: usize) {
         self.step += 1;
         self.visible[start] = self.step;
-        let mut order = vec![start];
+        self.seen.clear();
+        self.seen.push(start);
         let mut next = 0;
-        while let Some(&f) = order.get(next) {
+        while let Some(&f) = self.seen.get(next) {
             next += 1;
             for k in 0..3 {
                 let g = self.neighbors[f][k];
                 if self.visible[g] != self.step && self.sees(g, eye) {
                     self.visible[g] = self.step;
-                    order.push(g);
+                    self.seen.push(g);
                 }
             }
         }
-        order
     }
 
     fn into_hull(self) -> Hull {
-        let mut index = BTreeMap::new();
+        let mut index = vec![NONE; self.points.len()];
         let mut vertices = Vec::new();
         let triangles = (0..self.faces.len())
             .filter(|&f| self.alive[f])
             .map(|f| {
                 self.faces[f].map(|i| {
-                    *index.entry(i).or_insert_with(|| {
+                    if index[i] == NONE {
+                        index[i] = vertices.len();
                         vertices.push(self.points[i]);
-                        vertices.len() - 1
-                    })
+                    }
+                    index[i]
                 })
             })
             .collect();

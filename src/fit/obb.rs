@@ -305,9 +305,13 @@ fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     obb
 }
 
-/// How many face normals of the extremal points' hull the fast fit tries: all of them (a
+/// How many face normals of the extremal points' hull the fast fit bounds: all of them (a
 /// hull of 26 points has at most 48 faces).
 const FAST_NORMALS: usize = 48;
+/// How many of them get their rectangle in the fast fit: those of least bound (see
+/// [`face_frames`]). On the test meshes the best face frame is always among the first 8,
+/// and a rectangle costs as much as the bounds of every normal.
+const FAST_RECTANGLES: usize = 8;
 
 /// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
 /// points as given) and the best frame of the extremal points along the 13 sample
@@ -330,7 +334,7 @@ fn fit_fast(points: &[Vec3], summary: cloud::Summary) -> Result<Obb3, FitError> 
         Hull::Solid {
             vertices,
             triangles,
-        } => face_frames(&vertices, &triangles, FAST_NORMALS, 1),
+        } => face_frames(&vertices, &triangles, FAST_NORMALS, FAST_RECTANGLES, 1),
         _ => Vec::new(),
     };
     let best = dito
@@ -452,7 +456,13 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
             vertices,
             triangles,
         } => {
-            let scored = face_frames(&vertices, &triangles, MAX_FACE_NORMALS, REFINED);
+            let scored = face_frames(
+                &vertices,
+                &triangles,
+                MAX_FACE_NORMALS,
+                MAX_FACE_NORMALS,
+                REFINED,
+            );
             let frames = scored
                 .iter()
                 .take(REFINED)
@@ -466,9 +476,10 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
     }
 }
 
-/// The `keep` best frames among the distinct face normals of a hull ([`face_normals`]):
-/// for each normal, the frame of the minimum-area rectangle around the hull along it, with
-/// the volume of its box; smallest first.
+/// The `keep` best frames among the distinct face normals of a hull (the `normals` of
+/// largest area, [`face_normals`]): for each normal, the frame of the minimum-area
+/// rectangle around the hull along it, with the volume of its box; smallest first. At most
+/// `rectangles` rectangles are computed, for the normals of least bound (below).
 ///
 /// Most normals are ruled out without their rectangle. The box along `n` holds the hull,
 /// so its volume is at least the hull's extent along `n` times the area of the hull's
@@ -480,6 +491,7 @@ fn face_frames(
     vertices: &[DVec3],
     triangles: &[[usize; 3]],
     normals: usize,
+    rectangles: usize,
     keep: usize,
 ) -> Vec<(f64, DMat3)> {
     // Twice the faces' area vectors.
@@ -505,7 +517,7 @@ fn face_frames(
         .collect();
     bounded.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Vec<(f64, DMat3)> = Vec::with_capacity(keep + 1);
-    for (bound, n) in bounded {
+    for (bound, n) in bounded.into_iter().take(rectangles) {
         if best.len() == keep && best.last().is_some_and(|b| bound > b.0 * (1.0 + 1e-9)) {
             break;
         }

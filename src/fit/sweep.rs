@@ -178,12 +178,31 @@ pub(crate) fn projections(x: f32, y: f32, z: f32) -> [f32; DIRECTIONS] {
 }
 
 /// An extreme projection found so far: its value, and the points among which its first
-/// point lies (a chunk, or one point of the tail).
+/// point lies: those of the chunk `start..start + len` in the lanes of the mask `lanes`
+/// (point `start + i` is in lane `i mod WIDTH`), or one point of the tail.
 #[derive(Clone, Copy, Default)]
 struct Extreme {
     value: f32,
     start: usize,
     len: usize,
+    lanes: u32,
+}
+
+impl Extreme {
+    /// The first point among its candidates whose projection `project` is the extreme value;
+    /// `None` when none is (an overflowing projection, `inf` or NaN, may match none). Only
+    /// the lanes that reached the value are searched, a point in `WIDTH`.
+    fn first(&self, points: &[Vec3], project: impl Fn(Vec3) -> f32) -> Option<usize> {
+        let candidates = &points[self.start..self.start + self.len];
+        (0..WIDTH)
+            .filter(|&lane| self.lanes & (1 << lane) != 0)
+            .filter_map(|lane| {
+                let mut strided = candidates.iter().skip(lane).step_by(WIDTH);
+                let at = strided.position(|&p| project(p) == self.value)?;
+                Some(self.start + lane + at * WIDTH)
+            })
+            .min()
+    }
 }
 
 /// What one sweep learns of the points: the extremal points on the sample directions and
@@ -227,6 +246,7 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
         value,
         start: 0,
         len: 0,
+        lanes: 0,
     };
     let first = points.first().copied().unwrap_or(Vec3::ZERO);
     let s = first.as_dvec3().to_array();
@@ -268,17 +288,20 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
                     let greatest = hi[k]
                         .iter()
                         .fold(f32::NEG_INFINITY, |a, &b| if b > a { b } else { a });
-                    let at = |value| Extreme {
+                    let at = |value, lanes: &[f32; WIDTH]| Extreme {
                         value,
                         start: c * CHUNK * WIDTH,
                         len: CHUNK * WIDTH,
+                        lanes: (0..WIDTH)
+                            .filter(|&j| lanes[j] == value)
+                            .fold(0, |mask, j| mask | 1 << j),
                     };
                     // Strictly better only: the first chunk to reach a value keeps it.
                     if least < best[k][0].value {
-                        best[k][0] = at(least);
+                        best[k][0] = at(least, &lo[k]);
                     }
                     if greatest > best[k][1].value {
-                        best[k][1] = at(greatest);
+                        best[k][1] = at(greatest, &hi[k]);
                     }
                 }
             }
@@ -294,6 +317,7 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
                 value: q,
                 start: i,
                 len: 1,
+                lanes: 1,
             };
             if q < lo.value || lo.len == 0 {
                 *lo = here;
@@ -320,15 +344,10 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
         .enumerate()
         .flat_map(|(k, ends)| {
             ends.map(|e| {
-                let candidates = &points[e.start..e.start + e.len];
-                // The first point of its chunk with the value; an overflowing projection
-                // (`inf` or NaN) may match none, and then any point will do.
-                let first = candidates
-                    .iter()
-                    .find(|&&p| project(p)[k] == e.value)
-                    .or(candidates.first())
-                    .or(points.first());
-                first.map_or(DVec3::ZERO, |p| p.as_dvec3())
+                // The first point of its chunk with the value; when none has it (an
+                // overflowing projection), any point will do.
+                let first = e.first(points, |p| project(p)[k]).unwrap_or(e.start);
+                points.get(first).map_or(DVec3::ZERO, |p| p.as_dvec3())
             })
         })
         .collect();
