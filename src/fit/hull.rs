@@ -225,15 +225,18 @@ impl<'a> Quickhull<'a> {
         } else {
             (b, c)
         };
+        // Room for the faces of a typical run (each step kills the faces it sees), so that
+        // small hulls never grow their vectors.
+        let faces = (8 * points.len() + 8).min(1 << 12);
         let mut hull = Self {
             points,
-            faces: Vec::new(),
-            neighbors: Vec::new(),
-            alive: Vec::new(),
-            first: Vec::new(),
-            last: Vec::new(),
+            faces: Vec::with_capacity(faces),
+            neighbors: Vec::with_capacity(faces),
+            alive: Vec::with_capacity(faces),
+            first: Vec::with_capacity(faces),
+            last: Vec::with_capacity(faces),
             next: vec![NONE; points.len()],
-            visible: Vec::new(),
+            visible: Vec::with_capacity(faces),
             step: 0,
             seen: Vec::new(),
             horizon: Vec::new(),

@@ -12,7 +12,6 @@ use super::search::compass_search;
 use super::sweep;
 use super::{Fit, FitError};
 use crate::aabb::Aabb3;
-use alloc::collections::BTreeMap;
 use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
 
 /// An oriented box: the points `x` with `|(x − center)·axis_k| <= half_extents[k]` for each
@@ -533,21 +532,23 @@ fn face_frames(
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
 /// `most` of them.
 fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Vec<DVec3> {
-    let mut by_direction: BTreeMap<[i64; 3], (f64, DVec3)> = BTreeMap::new();
-    for t in triangles {
-        let [a, b, c] = t.map(|i| vertices[i]);
-        let n = (b - a).cross(c - a);
-        let Some(unit) = n.try_normalize() else {
-            continue;
-        };
-        let key = (unit * f64::from(1u32 << 24))
-            .round()
-            .as_i64vec3()
-            .to_array();
-        let entry = by_direction.entry(key).or_insert((0.0, unit));
-        entry.0 += n.length();
-    }
-    let mut normals: Vec<(f64, DVec3)> = by_direction.into_values().collect();
+    // Each face's direction key, twice its area and its unit normal, by key (a stable sort:
+    // the first face of a direction gives its normal).
+    let mut faces: Vec<([i64; 3], f64, DVec3)> = triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i]);
+            let n = (b - a).cross(c - a);
+            let unit = n.try_normalize()?;
+            let key = (unit * f64::from(1u32 << 24)).round().as_i64vec3();
+            Some((key.to_array(), n.length(), unit))
+        })
+        .collect();
+    faces.sort_by_key(|f| f.0);
+    let mut normals: Vec<(f64, DVec3)> = faces
+        .chunk_by(|a, b| a.0 == b.0)
+        .map(|run| (run.iter().map(|f| f.1).sum(), run[0].2))
+        .collect();
     normals.sort_by(|a, b| b.0.total_cmp(&a.0));
     normals.into_iter().take(most).map(|(_, n)| n).collect()
 }
@@ -556,11 +557,11 @@ fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Ve
 /// points projected on the plane orthogonal to the unit `normal`.
 fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
     let (e1, e2) = normal.any_orthonormal_pair();
-    let flat: Vec<DVec2> = points
+    let mut flat: Vec<DVec2> = points
         .iter()
         .map(|p| DVec2::new(p.dot(e1), p.dot(e2)))
         .collect();
-    let (side, _) = min_area_rectangle(&flat);
+    let (side, _) = min_area_rectangle(&mut flat);
     let u = e1 * side.x + e2 * side.y;
     DMat3::from_cols(u, normal.cross(u), normal)
 }

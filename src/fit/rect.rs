@@ -10,44 +10,44 @@
 use alloc::vec::Vec;
 use glam::DVec2;
 
-/// The convex hull, counter-clockwise, without collinear vertices (any order of input).
-pub(crate) fn convex_hull_2d(points: &[DVec2]) -> Vec<DVec2> {
-    let mut sorted = points.to_vec();
-    // Unstable is enough: equal keys are equal points, which `dedup` merges.
-    sorted.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    sorted.dedup();
-    if sorted.len() < 3 {
-        return sorted;
-    }
-    // Lower chain left to right, upper chain right to left; each drops its last point,
-    // which starts the other.
-    let mut hull = half_hull(sorted.iter());
-    hull.pop();
-    let mut upper = half_hull(sorted.iter().rev());
-    upper.pop();
-    hull.append(&mut upper);
-    hull
-}
-
-/// One monotone chain: pops every vertex where the chain would not turn left.
-fn half_hull<'a>(points: impl Iterator<Item = &'a DVec2>) -> Vec<DVec2> {
-    let mut chain: Vec<DVec2> = Vec::new();
-    for &p in points {
-        while let [.., a, b] = chain[..] {
+/// The convex hull, counter-clockwise, without collinear vertices (any order of input),
+/// sorting the points in place.
+pub(crate) fn convex_hull_2d(points: &mut [DVec2]) -> Vec<DVec2> {
+    // Unstable is enough: equal keys are equal points, taken once.
+    points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let distinct = || points.chunk_by(|a, b| a == b).map(|run| run[0]);
+    // Adds `p` to the chain on top of `hull`, first popping every vertex above the first
+    // `floor` where the chain would not turn left.
+    let extend = |hull: &mut Vec<DVec2>, p: DVec2, floor: usize| {
+        while hull.len() > floor {
+            let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
             if (b - a).perp_dot(p - a) > 0.0 {
                 break;
             }
-            chain.pop();
+            hull.pop();
         }
-        chain.push(p);
+        hull.push(p);
+    };
+    // The lower chain left to right, then the upper chain right to left on top of it; the
+    // upper chain ends at the first point, which is dropped.
+    let mut hull = Vec::with_capacity(points.len() + 1);
+    for p in distinct() {
+        extend(&mut hull, p, 1);
     }
-    chain
+    let lower = hull.len();
+    for p in distinct().rev().skip(1) {
+        extend(&mut hull, p, lower);
+    }
+    if hull.len() > 1 {
+        hull.pop();
+    }
+    hull
 }
 
 /// The unit direction of one side of the minimum-area rectangle around `points`, and the
 /// rectangle's area. For fewer than three hull vertices: the direction of the segment
 /// (or `x`) and area 0.
-pub(crate) fn min_area_rectangle(points: &[DVec2]) -> (DVec2, f64) {
+pub(crate) fn min_area_rectangle(points: &mut [DVec2]) -> (DVec2, f64) {
     let hull = convex_hull_2d(points);
     let m = hull.len();
     if m < 3 {
@@ -105,17 +105,49 @@ mod tests {
             .iter()
             .map(|&(x, y)| r.rotate(DVec2::new(x, y)))
             .collect();
-        assert_eq!(convex_hull_2d(&pts).len(), 4);
-        let (dir, area) = min_area_rectangle(&pts);
+        let mut pts = pts;
+        assert_eq!(convex_hull_2d(&mut pts).len(), 4);
+        let (dir, area) = min_area_rectangle(&mut pts);
         assert!((area - 4.0).abs() < 1e-12, "{area}");
         assert!(
             dir.perp_dot(r).abs() < 1e-12 || dir.dot(r).abs() < 1e-12,
             "{dir}"
         );
-        let diamond: Vec<DVec2> = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)]
+        let mut diamond: Vec<DVec2> = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)]
             .iter()
             .map(|&(x, y)| DVec2::new(x, y))
             .collect();
-        assert!((min_area_rectangle(&diamond).1 - 2.0).abs() < 1e-12);
+        assert!((min_area_rectangle(&mut diamond).1 - 2.0).abs() < 1e-12);
+    }
+
+    /// Repeated and collinear points: one point, the two ends of a segment, and a
+    /// triangle whose edges hold repeated points, each vertex once and counter-clockwise.
+    #[test]
+    fn hulls_of_repeated_and_collinear_points() {
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        assert_eq!(convex_hull_2d(&mut [p(1.0, 2.0); 3]), [p(1.0, 2.0)]);
+        let mut segment = [
+            p(2.0, 2.0),
+            p(0.0, 0.0),
+            p(1.0, 1.0),
+            p(2.0, 2.0),
+            p(0.0, 0.0),
+        ];
+        assert_eq!(convex_hull_2d(&mut segment), [p(0.0, 0.0), p(2.0, 2.0)]);
+        let mut triangle = [
+            p(0.0, 0.0),
+            p(4.0, 0.0),
+            p(2.0, 0.0),
+            p(0.0, 4.0),
+            p(2.0, 2.0),
+            p(0.0, 2.0),
+            p(4.0, 0.0),
+            p(0.0, 0.0),
+            p(1.0, 1.0),
+        ];
+        assert_eq!(
+            convex_hull_2d(&mut triangle),
+            [p(0.0, 0.0), p(4.0, 0.0), p(0.0, 4.0)]
+        );
     }
 }

@@ -229,7 +229,8 @@ const ENTRIES: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2
 /// the sweeps are bound by memory, not arithmetic).
 ///
 /// **Extremes.** The lanes keep only the least and greatest values of each chunk of
-/// [`CHUNK`] groups; a chunk that strictly improves an extreme becomes its chunk, and the
+/// [`CHUNK`] groups (the last chunk may be shorter; only the last `n mod WIDTH` points go
+/// one at a time); a chunk that strictly improves an extreme becomes its chunk, and the
 /// first point of that chunk with the extreme value is found at the end, by evaluating the
 /// same sums one point at a time (the same bits: IEEE operations in the same order).
 ///
@@ -256,7 +257,8 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             let mut best = [[none(f32::INFINITY), none(f32::NEG_INFINITY)]; DIRECTIONS];
             let mut sum = [[0.0f64; WIDTH]; 3];
             let mut products = [[0.0f64; WIDTH]; 6];
-            for (c, chunk) in points.chunks_exact(CHUNK * WIDTH).enumerate() {
+            // The last chunk may be short; its full groups still run in lanes.
+            for (c, chunk) in points.chunks(CHUNK * WIDTH).enumerate() {
                 let mut lo = [[f32::INFINITY; WIDTH]; DIRECTIONS];
                 let mut hi = [[f32::NEG_INFINITY; WIDTH]; DIRECTIONS];
                 for group in chunk.as_chunks::<WIDTH>().0 {
@@ -291,7 +293,7 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
                     let at = |value, lanes: &[f32; WIDTH]| Extreme {
                         value,
                         start: c * CHUNK * WIDTH,
-                        len: CHUNK * WIDTH,
+                        len: chunk.len(),
                         lanes: (0..WIDTH)
                             .filter(|&j| lanes[j] == value)
                             .fold(0, |mask, j| mask | 1 << j),
@@ -308,9 +310,9 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             (best, sum, products)
         },
     );
-    // The tail, one point at a time: its sums go to lane 0.
+    // The tail (fewer than `WIDTH` points), one point at a time: its sums go to lane 0.
     let project = |p: Vec3| projections(p.x, p.y, p.z);
-    let tail = points.len() - points.len() % (CHUNK * WIDTH);
+    let tail = points.len() - points.len() % WIDTH;
     for (i, &p) in points.iter().enumerate().skip(tail) {
         for (q, [lo, hi]) in project(p).into_iter().zip(&mut extremes) {
             let here = Extreme {
