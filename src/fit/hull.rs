@@ -28,13 +28,85 @@ pub(crate) enum Hull {
     Segment(DVec3),
     /// All points lie on a plane with this unit normal.
     Planar(DVec3),
-    /// A solid hull: its vertices and its outward (counter-clockwise) triangles into them.
-    Solid {
-        /// The hull vertices.
-        vertices: Vec<DVec3>,
-        /// Triangles, as indices into `vertices`.
-        triangles: Vec<[usize; 3]>,
-    },
+    /// A solid hull.
+    Solid(Solid),
+}
+
+/// A solid hull: its vertices and its outward (counter-clockwise) triangles into them,
+/// with their neighbours and area vectors.
+#[derive(Clone, Debug)]
+pub(crate) struct Solid {
+    /// The hull vertices.
+    pub vertices: Vec<DVec3>,
+    /// Triangles, as indices into `vertices`.
+    pub triangles: Vec<[usize; 3]>,
+    /// `neighbors[t][k]`: the triangle across edge `k` of triangle `t`, from its vertex `k`
+    /// to its vertex `k + 1`.
+    pub neighbors: Vec<[usize; 3]>,
+    /// Each triangle's doubled area vector `(b − a) × (c − a)`, outward.
+    pub areas: Vec<DVec3>,
+    /// Each triangle's `|b − a|₁·|c − a|₁`, which bounds the rounding of its area vector.
+    scales: Vec<f64>,
+}
+
+impl Solid {
+    /// The hull from its vertices, triangles and neighbours.
+    fn new(vertices: Vec<DVec3>, triangles: Vec<[usize; 3]>, neighbors: Vec<[usize; 3]>) -> Self {
+        let (areas, scales) = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| vertices[i]);
+                let (ab, ac) = (b - a, c - a);
+                (
+                    ab.cross(ac),
+                    ab.abs().element_sum() * ac.abs().element_sum(),
+                )
+            })
+            .unzip();
+        Self {
+            vertices,
+            triangles,
+            neighbors,
+            areas,
+            scales,
+        }
+    }
+
+    /// The vertices on the hull's outline seen along the unit direction `n`, some more than
+    /// once: among them, every vertex whose projection on the plane orthogonal to `n` is a
+    /// corner of the hull's shadow there. So the shadow's convex hull is that of the
+    /// outline's projection, found from a few vertices rather than all of them.
+    ///
+    /// A triangle faces `n` when `n·A > 2^-40·s` for its area vector `A` and its scale `s`
+    /// (the `f64` value of `n·A` is within a few `u = 2^-53` of `s`, so a triangle that faces
+    /// `n` really does), and is *edge-on* when `|n·A| <= 2^-40·s`. The outline holds the ends
+    /// of each edge between a triangle that faces `n` and one that does not, and every
+    /// vertex of an edge-on triangle.
+    ///
+    /// *Proof* that it holds each corner vertex `v`: some direction `d ⟂ n` is maximised at
+    /// `v`, so `d` is in the cone spanned by the normals of the triangles around `v`. They
+    /// cannot all face `n` (then `n·d > 0`), nor all face strictly away from it (then
+    /// `n·d < 0`): so either one is edge-on, or both kinds meet at an edge at `v` (the
+    /// triangles around `v` form a cycle).
+    pub fn outline(&self, n: DVec3) -> Vec<usize> {
+        let band = |t: usize| pow2(-40) * self.scales[t];
+        let faces: Vec<bool> = (0..self.triangles.len())
+            .map(|t| n.dot(self.areas[t]) > band(t))
+            .collect();
+        let mut outline = Vec::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if faces[t] {
+                for k in 0..3 {
+                    if !faces[self.neighbors[t][k]] {
+                        outline.extend([tri[k], tri[(k + 1) % 3]]);
+                    }
+                }
+            } else if n.dot(self.areas[t]).abs() <= band(t) {
+                outline.extend(tri);
+            }
+        }
+        outline
+    }
 }
 
 fn coord(p: DVec3) -> Coord3D<f64> {
@@ -156,21 +228,14 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let inner_seed = seed.map(|i| extremal.binary_search(&i).unwrap_or(0));
     let mut inner = Quickhull::new(&subset, inner_seed);
     inner.run();
-    let Hull::Solid {
-        vertices,
-        triangles,
-    } = inner.into_hull()
-    else {
+    let Hull::Solid(solid) = inner.into_hull() else {
         return all();
     };
     // Each face: a vertex, its normal, and the pad factor 2^-40·|b − a|₁·|c − a|₁.
-    let faces: Vec<(DVec3, DVec3, f64)> = triangles
-        .iter()
+    let faces: Vec<(DVec3, DVec3, f64)> = (0..solid.triangles.len())
         .map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i]);
-            let (ab, ac) = (b - a, c - a);
-            let pad = pow2(-40) * ab.abs().element_sum() * ac.abs().element_sum();
-            (a, ab.cross(ac), pad)
+            let a = solid.vertices[solid.triangles[t][0]];
+            (a, solid.areas[t], pow2(-40) * solid.scales[t])
         })
         .collect();
     let inside = |p: DVec3| {
@@ -391,9 +456,15 @@ impl<'a> Quickhull<'a> {
     fn into_hull(self) -> Hull {
         let mut index = vec![NONE; self.points.len()];
         let mut vertices = Vec::new();
-        let triangles = (0..self.faces.len())
-            .filter(|&f| self.alive[f])
-            .map(|f| {
+        let alive: Vec<usize> = (0..self.faces.len()).filter(|&f| self.alive[f]).collect();
+        // The live faces' new numbers, for their neighbours.
+        let mut number = vec![NONE; self.faces.len()];
+        for (t, &f) in alive.iter().enumerate() {
+            number[f] = t;
+        }
+        let triangles = alive
+            .iter()
+            .map(|&f| {
                 self.faces[f].map(|i| {
                     if index[i] == NONE {
                         index[i] = vertices.len();
@@ -403,10 +474,11 @@ impl<'a> Quickhull<'a> {
                 })
             })
             .collect();
-        Hull::Solid {
-            vertices,
-            triangles,
-        }
+        let neighbors = alive
+            .iter()
+            .map(|&f| self.neighbors[f].map(|g| number[g]))
+            .collect();
+        Hull::Solid(Solid::new(vertices, triangles, neighbors))
     }
 }
 
@@ -424,10 +496,11 @@ mod tests {
             DVec3::new(0.5, 0.5, 1.0),
             DVec3::new(0.25, 0.0, 0.5),
         ]);
-        let Hull::Solid {
+        let Hull::Solid(Solid {
             vertices,
             triangles,
-        } = convex_hull(&points)
+            ..
+        }) = convex_hull(&points)
         else {
             panic!("a cube is solid");
         };
@@ -472,7 +545,7 @@ mod tests {
         // Points on the segment between two extremal points lie on the filter's hull.
         points.push((points[0] + points[1]) * 0.5);
         let vertices = |hull: Hull| match hull {
-            Hull::Solid { vertices, .. } => {
+            Hull::Solid(Solid { vertices, .. }) => {
                 let mut v: Vec<[u64; 3]> = vertices
                     .iter()
                     .map(|p| p.to_array().map(f64::to_bits))
@@ -487,5 +560,62 @@ mod tests {
         full.run();
         assert_eq!(filtered, vertices(full.into_hull()));
         assert_eq!(filtered.len(), 667, "every point on the sphere");
+    }
+
+    /// The outline's shadow is the whole hull's: seen along the face normals, the axes
+    /// (which leave faces of a cube edge-on) and random directions, every vertex projects
+    /// inside the convex hull of the outline's projection.
+    #[test]
+    fn the_outline_casts_the_hull_shadow() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let cube: Vec<DVec3> = (0..27)
+            .map(|k| DVec3::new((k % 3) as f64, (k / 3 % 3) as f64, (k / 9) as f64))
+            .collect();
+        let ball: Vec<DVec3> = (0..300)
+            .map(|_| DVec3::new(next(), next(), next()).normalize() * (1.0 + 0.1 * next()))
+            .map(|p| p.as_vec3().as_dvec3())
+            .collect();
+        for (points, round) in [(cube, false), (ball, true)] {
+            let Hull::Solid(hull) = convex_hull(&points) else {
+                panic!("solid");
+            };
+            let mut directions: Vec<DVec3> = hull.areas.iter().map(|a| a.normalize()).collect();
+            directions.extend([DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE.normalize()]);
+            directions.extend((0..50).map(|_| DVec3::new(next(), next(), next()).normalize()));
+            for n in directions {
+                let (e1, e2) = n.any_orthonormal_pair();
+                let flat = |p: DVec3| glam::DVec2::new(p.dot(e1), p.dot(e2));
+                let outline = hull.outline(n);
+                if round {
+                    // The point of it: a rim of the ball, not all of it.
+                    let mut distinct = outline.clone();
+                    distinct.sort_unstable();
+                    distinct.dedup();
+                    assert!(
+                        distinct.len() * 3 < hull.vertices.len(),
+                        "{}",
+                        distinct.len()
+                    );
+                }
+                let mut shadow: Vec<_> = outline.iter().map(|&i| flat(hull.vertices[i])).collect();
+                let shadow = crate::fit::rect::convex_hull_2d(&mut shadow);
+                for &v in &hull.vertices {
+                    let q = flat(v);
+                    for (k, &a) in shadow.iter().enumerate() {
+                        let b = shadow[(k + 1) % shadow.len()];
+                        assert!(
+                            (b - a).perp_dot(q - a) >= -1e-12,
+                            "{q} outside the shadow along {n}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

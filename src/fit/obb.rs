@@ -6,7 +6,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::eigen::principal_axes;
-use super::hull::{Hull, convex_hull};
+use super::hull::{Hull, Solid, convex_hull};
 use super::rect::min_area_rectangle;
 use super::search::compass_search;
 use super::sweep;
@@ -330,10 +330,7 @@ fn fit_fast(points: &[Vec3], summary: cloud::Summary) -> Result<Obb3, FitError> 
     });
     extremal.dedup();
     let faces = match convex_hull(&extremal) {
-        Hull::Solid {
-            vertices,
-            triangles,
-        } => face_frames(&vertices, &triangles, FAST_NORMALS, FAST_RECTANGLES, 1),
+        Hull::Solid(hull) => face_frames(&hull, FAST_NORMALS, FAST_RECTANGLES, 1),
         _ => Vec::new(),
     };
     let best = dito
@@ -450,26 +447,17 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
     match convex_hull(points) {
         Hull::Point => one(None),
         Hull::Segment(line) => one(frame_from(line, DVec3::ZERO)),
-        Hull::Planar(normal) => one(Some(rectangle_frame(normal, points))),
-        Hull::Solid {
-            vertices,
-            triangles,
-        } => {
-            let scored = face_frames(
-                &vertices,
-                &triangles,
-                MAX_FACE_NORMALS,
-                MAX_FACE_NORMALS,
-                REFINED,
-            );
+        Hull::Planar(normal) => one(Some(rectangle_frame(normal, points.iter().copied()))),
+        Hull::Solid(hull) => {
+            let scored = face_frames(&hull, MAX_FACE_NORMALS, MAX_FACE_NORMALS, REFINED);
             let frames = scored
                 .iter()
                 .take(REFINED)
-                .map(|&(_, f)| refine(f, &vertices))
+                .map(|&(_, f)| refine(f, &hull.vertices))
                 .collect();
             TightFrames {
                 frames,
-                support: vertices,
+                support: hull.vertices,
             }
         }
     }
@@ -477,8 +465,9 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 
 /// The `keep` best frames among the distinct face normals of a hull (the `normals` of
 /// largest area, [`face_normals`]): for each normal, the frame of the minimum-area
-/// rectangle around the hull along it, with the volume of its box; smallest first. At most
-/// `rectangles` rectangles are computed, for the normals of least bound (below).
+/// rectangle around the hull along it (found from the hull's outline along it,
+/// [`Solid::outline`]), with the volume of its box; smallest first. At most `rectangles`
+/// rectangles are computed, for the normals of least bound (below).
 ///
 /// Most normals are ruled out without their rectangle. The box along `n` holds the hull,
 /// so its volume is at least the hull's extent along `n` times the area of the hull's
@@ -486,22 +475,9 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// `½·Σ_f |n·A_f|` over its faces' area vectors `A_f` (the projection is covered twice).
 /// Normals are taken in order of that bound, and once it exceeds the `keep`-th best
 /// volume found (with a relative margin of `10^-9` for its rounding), none left can enter.
-fn face_frames(
-    vertices: &[DVec3],
-    triangles: &[[usize; 3]],
-    normals: usize,
-    rectangles: usize,
-    keep: usize,
-) -> Vec<(f64, DMat3)> {
-    // Twice the faces' area vectors.
-    let areas: Vec<DVec3> = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i]);
-            (b - a).cross(c - a)
-        })
-        .collect();
-    let mut bounded: Vec<(f64, DVec3)> = face_normals(vertices, triangles, normals)
+fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> Vec<(f64, DMat3)> {
+    let (vertices, areas) = (&hull.vertices, &hull.areas);
+    let mut bounded: Vec<(f64, DVec3)> = face_normals(hull, normals)
         .into_iter()
         .map(|n| {
             let (lo, hi) = vertices
@@ -520,7 +496,8 @@ fn face_frames(
         if best.len() == keep && best.last().is_some_and(|b| bound > b.0 * (1.0 + 1e-9)) {
             break;
         }
-        let frame = rectangle_frame(n, vertices);
+        let outline = hull.outline(n).into_iter().map(|i| vertices[i]);
+        let frame = rectangle_frame(n, outline);
         let volume = volume_over(&frame, vertices);
         let at = best.partition_point(|b| b.0 <= volume);
         best.insert(at, (volume, frame));
@@ -531,14 +508,13 @@ fn face_frames(
 
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
 /// `most` of them.
-fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Vec<DVec3> {
+fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
     // Each face's direction key, twice its area and its unit normal, by key (a stable sort:
     // the first face of a direction gives its normal).
-    let mut faces: Vec<([i64; 3], f64, DVec3)> = triangles
+    let mut faces: Vec<([i64; 3], f64, DVec3)> = hull
+        .areas
         .iter()
-        .filter_map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i]);
-            let n = (b - a).cross(c - a);
+        .filter_map(|&n| {
             let unit = n.try_normalize()?;
             let key = (unit * f64::from(1u32 << 24)).round().as_i64vec3();
             Some((key.to_array(), n.length(), unit))
@@ -555,12 +531,9 @@ fn face_normals(vertices: &[DVec3], triangles: &[[usize; 3]], most: usize) -> Ve
 
 /// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
 /// points projected on the plane orthogonal to the unit `normal`.
-fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
+fn rectangle_frame(normal: DVec3, points: impl Iterator<Item = DVec3>) -> DMat3 {
     let (e1, e2) = normal.any_orthonormal_pair();
-    let mut flat: Vec<DVec2> = points
-        .iter()
-        .map(|p| DVec2::new(p.dot(e1), p.dot(e2)))
-        .collect();
+    let mut flat: Vec<DVec2> = points.map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect();
     let (side, _) = min_area_rectangle(&mut flat);
     let u = e1 * side.x + e2 * side.y;
     DMat3::from_cols(u, normal.cross(u), normal)
