@@ -14,9 +14,10 @@
 //! point).
 
 use crate::num::pow2;
+use alloc::boxed::Box;
 use alloc::vec;
 use alloc::vec::Vec;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use robust::{Coord, Coord3D, orient2d, orient3d};
 
 /// The convex hull, by the dimension of the points' affine hull.
@@ -29,7 +30,7 @@ pub(crate) enum Hull {
     /// All points lie on a plane with this unit normal.
     Planar(DVec3),
     /// A solid hull.
-    Solid(Solid),
+    Solid(Box<Solid>),
 }
 
 /// A solid hull: its vertices and its outward (counter-clockwise) triangles into them,
@@ -47,6 +48,9 @@ pub(crate) struct Solid {
     pub areas: Vec<DVec3>,
     /// Each triangle's `|b − a|₁·|c − a|₁`, which bounds the rounding of its area vector.
     scales: Vec<f64>,
+    /// The vertices joined to vertex `v` by an edge: `links[starts[v]..starts[v + 1]]`.
+    starts: Vec<usize>,
+    links: Vec<usize>,
 }
 
 impl Solid {
@@ -63,13 +67,69 @@ impl Solid {
                 )
             })
             .unzip();
+        // Each edge `u → v` of a triangle runs `v → u` in its neighbour: listing every
+        // triangle's edges by their first vertex lists each vertex's neighbours once.
+        let mut starts = vec![0; vertices.len() + 1];
+        for t in &triangles {
+            for &u in t {
+                starts[u + 1] += 1;
+            }
+        }
+        for v in 0..vertices.len() {
+            starts[v + 1] += starts[v];
+        }
+        let mut links = vec![0; starts[vertices.len()]];
+        let mut filled = starts.clone();
+        for t in &triangles {
+            for k in 0..3 {
+                links[filled[t[k]]] = t[(k + 1) % 3];
+                filled[t[k]] += 1;
+            }
+        }
         Self {
             vertices,
             triangles,
             neighbors,
             areas,
             scales,
+            starts,
+            links,
         }
+    }
+
+    /// The vertex of greatest projection on `d`, found by climbing from vertex `from` to a
+    /// neighbour of greater projection while there is one. On a convex polytope a vertex
+    /// that no edge leaves uphill is a highest one (the edges at a vertex span the
+    /// polytope's cone there), so the climb visits a path, not the whole hull; each step
+    /// strictly gains, so it ends.
+    pub fn extreme(&self, d: DVec3, from: usize) -> usize {
+        let (mut at, mut height) = (from, self.vertices[from].dot(d));
+        loop {
+            let here = at;
+            for &w in &self.links[self.starts[here]..self.starts[here + 1]] {
+                let h = self.vertices[w].dot(d);
+                if h > height {
+                    (at, height) = (w, h);
+                }
+            }
+            if at == here {
+                return at;
+            }
+        }
+    }
+
+    /// The extents `max − min` of the hull on the columns of `frame`, by six climbs
+    /// ([`Solid::extreme`]) from the vertices in `from` (the lowest and highest on each
+    /// column of a nearby frame), which are updated: a box's size near a known one in a few
+    /// steps each.
+    pub fn extents(&self, frame: &DMat3, from: &mut [usize; 6]) -> DVec3 {
+        DVec3::from_array([0, 1, 2].map(|k| {
+            let axis = frame.col(k);
+            from[2 * k] = self.extreme(-axis, from[2 * k]);
+            from[2 * k + 1] = self.extreme(axis, from[2 * k + 1]);
+            let [lo, hi] = [from[2 * k], from[2 * k + 1]].map(|i| self.vertices[i].dot(axis));
+            (hi - lo).max(0.0)
+        }))
     }
 
     /// The vertices on the hull's outline seen along the unit direction `n`, some more than
@@ -231,22 +291,59 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let Hull::Solid(solid) = inner.into_hull() else {
         return all();
     };
-    // Each face: a vertex, its normal, and the pad factor 2^-40·|b − a|₁·|c − a|₁.
-    let faces: Vec<(DVec3, DVec3, f64)> = (0..solid.triangles.len())
+    let faces: Vec<Plane> = solid
+        .triangles
+        .iter()
         .map(|t| {
-            let a = solid.vertices[solid.triangles[t][0]];
-            (a, solid.areas[t], pow2(-40) * solid.scales[t])
+            let [a, b, c] = t.map(|i| solid.vertices[i]);
+            Plane::new(a, b, c)
         })
         .collect();
-    let inside = |p: DVec3| {
-        faces.iter().all(|&(a, n, pad)| {
-            let d = p - a;
-            n.dot(d) < -pad * d.abs().element_sum()
-        })
-    };
+    let inside = |p: DVec3| faces.iter().all(|f| f.side(p) == Some(false));
     (0..points.len())
         .filter(|&i| extremal.binary_search(&i).is_ok() || !inside(points[i]))
         .collect()
+}
+
+/// A face's plane, for a filter on the side of a point: a vertex `a`, the normal
+/// `n = (b − a) × (c − a)` and the pad factor `2^-40·|b − a|₁·|c − a|₁`.
+///
+/// The `f64` value of `n·(p − a)` is within a few `u = 2^-53` times
+/// `|b − a|₁·|c − a|₁·|p − a|₁` of the exact one (products of differences of `f32` values
+/// neither overflow nor underflow `f64`), far below the pad, `2^-40` times that; beyond the
+/// pad its sign is the exact sign.
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    a: DVec3,
+    n: DVec3,
+    pad: f64,
+}
+
+impl Plane {
+    fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
+        let (ab, ac) = (b - a, c - a);
+        Self {
+            a,
+            n: ab.cross(ac),
+            pad: pow2(-40) * ab.abs().element_sum() * ac.abs().element_sum(),
+        }
+    }
+
+    /// `Some(true)` when `p` lies strictly above the plane (on the side of `n`),
+    /// `Some(false)` strictly below, `None` within the pad (undecided).
+    #[inline]
+    fn side(&self, p: DVec3) -> Option<bool> {
+        let d = p - self.a;
+        let height = self.n.dot(d);
+        let pad = self.pad * d.abs().element_sum();
+        if height > pad {
+            Some(true)
+        } else if height < -pad {
+            Some(false)
+        } else {
+            None
+        }
+    }
 }
 
 /// No face or point: the end of an outside list, a point on no list.
@@ -260,6 +357,7 @@ const NONE: usize = usize::MAX;
 struct Quickhull<'a> {
     points: &'a [DVec3],
     faces: Vec<[usize; 3]>,
+    planes: Vec<Plane>,
     /// `neighbors[f][k]`: the face across edge `k` of face `f`, `faces[f][k] → faces[f][k + 1]`
     /// (it runs the other way).
     neighbors: Vec<[usize; 3]>,
@@ -296,6 +394,7 @@ impl<'a> Quickhull<'a> {
         let mut hull = Self {
             points,
             faces: Vec::with_capacity(faces),
+            planes: Vec::with_capacity(faces),
             neighbors: Vec::with_capacity(faces),
             alive: Vec::with_capacity(faces),
             first: Vec::with_capacity(faces),
@@ -327,6 +426,8 @@ impl<'a> Quickhull<'a> {
 
     fn add_face(&mut self, face: [usize; 3]) -> usize {
         let id = self.faces.len();
+        let [a, b, c] = face.map(|i| self.points[i]);
+        self.planes.push(Plane::new(a, b, c));
         self.faces.push(face);
         self.neighbors.push([id; 3]);
         self.alive.push(true);
@@ -336,9 +437,14 @@ impl<'a> Quickhull<'a> {
         id
     }
 
+    /// Exact: the face sees the point (it lies strictly above the face's plane); the
+    /// plane's filter decides, and `orient3d` when it cannot.
     fn sees(&self, face: usize, point: usize) -> bool {
-        let [a, b, c] = self.faces[face].map(|i| self.points[i]);
-        above(a, b, c, self.points[point])
+        let p = self.points[point];
+        self.planes[face].side(p).unwrap_or_else(|| {
+            let [a, b, c] = self.faces[face].map(|i| self.points[i]);
+            above(a, b, c, p)
+        })
     }
 
     /// The points of a face's outside set, in the order they were assigned.
@@ -366,8 +472,7 @@ impl<'a> Quickhull<'a> {
     /// The point of the face's outside set farthest from its plane (`f64` is enough: any
     /// point that the face sees is a valid choice); the last of them on ties.
     fn eye(&self, face: usize) -> usize {
-        let [a, b, c] = self.faces[face].map(|i| self.points[i]);
-        let n = (b - a).cross(c - a);
+        let Plane { a, n, .. } = self.planes[face];
         let height = |i: usize| (self.points[i] - a).dot(n);
         self.outside(face)
             .max_by(|&i, &j| height(i).total_cmp(&height(j)))
@@ -478,7 +583,7 @@ impl<'a> Quickhull<'a> {
             .iter()
             .map(|&f| self.neighbors[f].map(|g| number[g]))
             .collect();
-        Hull::Solid(Solid::new(vertices, triangles, neighbors))
+        Hull::Solid(Box::new(Solid::new(vertices, triangles, neighbors)))
     }
 }
 
@@ -496,14 +601,14 @@ mod tests {
             DVec3::new(0.5, 0.5, 1.0),
             DVec3::new(0.25, 0.0, 0.5),
         ]);
-        let Hull::Solid(Solid {
+        let Hull::Solid(hull) = convex_hull(&points) else {
+            panic!("a cube is solid");
+        };
+        let Solid {
             vertices,
             triangles,
             ..
-        }) = convex_hull(&points)
-        else {
-            panic!("a cube is solid");
-        };
+        } = *hull;
         assert_eq!(vertices.len(), 8);
         assert_eq!(triangles.len(), 12);
         for t in &triangles {
@@ -545,7 +650,8 @@ mod tests {
         // Points on the segment between two extremal points lie on the filter's hull.
         points.push((points[0] + points[1]) * 0.5);
         let vertices = |hull: Hull| match hull {
-            Hull::Solid(Solid { vertices, .. }) => {
+            Hull::Solid(hull) => {
+                let vertices = hull.vertices;
                 let mut v: Vec<[u64; 3]> = vertices
                     .iter()
                     .map(|p| p.to_array().map(f64::to_bits))
@@ -564,9 +670,10 @@ mod tests {
 
     /// The outline's shadow is the whole hull's: seen along the face normals, the axes
     /// (which leave faces of a cube edge-on) and random directions, every vertex projects
-    /// inside the convex hull of the outline's projection.
+    /// inside the convex hull of the outline's projection; and the climbs reach the
+    /// highest vertex along each direction.
     #[test]
-    fn the_outline_casts_the_hull_shadow() {
+    fn the_outline_casts_the_hull_shadow_and_the_climbs_reach_the_top() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = || {
             state ^= state << 13;
@@ -589,6 +696,15 @@ mod tests {
             directions.extend([DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE.normalize()]);
             directions.extend((0..50).map(|_| DVec3::new(next(), next(), next()).normalize()));
             for n in directions {
+                // The climb reaches the highest vertex, from any vertex.
+                let top = hull
+                    .vertices
+                    .iter()
+                    .map(|v| v.dot(n))
+                    .fold(f64::MIN, f64::max);
+                for from in [0, hull.vertices.len() / 2] {
+                    assert_eq!(hull.vertices[hull.extreme(n, from)].dot(n), top);
+                }
                 let (e1, e2) = n.any_orthonormal_pair();
                 let flat = |p: DVec3| glam::DVec2::new(p.dot(e1), p.dot(e2));
                 let outline = hull.outline(n);

@@ -453,7 +453,7 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
             let frames = scored
                 .iter()
                 .take(REFINED)
-                .map(|&(_, f)| refine(f, &hull.vertices))
+                .map(|&(_, f)| refine(f, &hull))
                 .collect();
             TightFrames {
                 frames,
@@ -492,13 +492,15 @@ fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> 
         .collect();
     bounded.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Vec<(f64, DMat3)> = Vec::with_capacity(keep + 1);
+    // Each box's extremes start the climbs of the next.
+    let mut from = [0; 6];
     for (bound, n) in bounded.into_iter().take(rectangles) {
         if best.len() == keep && best.last().is_some_and(|b| bound > b.0 * (1.0 + 1e-9)) {
             break;
         }
         let outline = hull.outline(n).into_iter().map(|i| vertices[i]);
         let frame = rectangle_frame(n, outline);
-        let volume = volume_over(&frame, vertices);
+        let volume = hull.extents(&frame, &mut from).element_product();
         let at = best.partition_point(|b| b.0 <= volume);
         best.insert(at, (volume, frame));
         best.truncate(keep);
@@ -539,11 +541,14 @@ fn rectangle_frame(normal: DVec3, points: impl Iterator<Item = DVec3>) -> DMat3 
     DMat3::from_cols(u, normal.cross(u), normal)
 }
 
-/// A local minimum of the volume over rotations `frame·exp(ω)` near `frame`.
-fn refine(frame: DMat3, points: &[DVec3]) -> DMat3 {
+/// A local minimum of the volume over rotations `frame·exp(ω)` near `frame`, each volume
+/// measured on the hull by climbs from the last box's extremes ([`Solid::extents`]).
+fn refine(frame: DMat3, hull: &Solid) -> DMat3 {
     let rotated =
         |w: [f64; 3]| frame * DMat3::from_quat(DQuat::from_scaled_axis(DVec3::from_array(w)));
-    let (w, _) = compass_search(|w| volume_over(&rotated(w), points), 0.05, 1e-7, 3000);
+    let mut from = [0; 6];
+    let mut volume = |w| hull.extents(&rotated(w), &mut from).element_product();
+    let (w, _) = compass_search(&mut volume, 0.05, 1e-7, 3000);
     rotated(w)
 }
 
