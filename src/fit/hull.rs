@@ -46,17 +46,23 @@ pub(crate) struct Solid {
     pub neighbors: Vec<[usize; 3]>,
     /// Each triangle's doubled area vector `(b − a) × (c − a)`, outward.
     pub areas: Vec<DVec3>,
-    /// Each triangle's `|b − a|₁·|c − a|₁`, which bounds the rounding of its area vector.
-    scales: Vec<f64>,
     /// The vertices joined to vertex `v` by an edge: `links[starts[v]..starts[v + 1]]`.
     starts: Vec<usize>,
     links: Vec<usize>,
+    /// The area vectors' coordinate columns, and `2^-40` times each triangle's scale
+    /// `|b − a|₁·|c − a|₁` (which bounds the rounding of its area vector), in lanes of
+    /// [`LANES`] (the last padded with zeros), for [`Solid::shadow`] and [`Solid::outline`].
+    columns: [Vec<[f64; LANES]>; 3],
+    bands: Vec<[f64; LANES]>,
 }
+
+/// Triangles per lane group of [`Solid::shadow`] and [`Solid::outline`].
+const LANES: usize = 4;
 
 impl Solid {
     /// The hull from its vertices, triangles and neighbours.
     fn new(vertices: Vec<DVec3>, triangles: Vec<[usize; 3]>, neighbors: Vec<[usize; 3]>) -> Self {
-        let (areas, scales) = triangles
+        let (areas, scales): (Vec<DVec3>, Vec<f64>) = triangles
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| vertices[i]);
@@ -86,15 +92,48 @@ impl Solid {
                 filled[t[k]] += 1;
             }
         }
+        let lanes = |value: &dyn Fn(usize) -> f64| -> Vec<[f64; LANES]> {
+            (0..triangles.len().div_ceil(LANES))
+                .map(|g| {
+                    core::array::from_fn(|j| {
+                        let t = g * LANES + j;
+                        if t < triangles.len() { value(t) } else { 0.0 }
+                    })
+                })
+                .collect()
+        };
+        let columns = [0, 1, 2].map(|k| lanes(&|t| areas[t][k]));
+        let bands = lanes(&|t| pow2(-40) * scales[t]);
         Self {
             vertices,
             triangles,
             neighbors,
             areas,
-            scales,
             starts,
             links,
+            columns,
+            bands,
         }
+    }
+
+    /// The area of the hull's shadow on the plane orthogonal to the unit `n`,
+    /// `¼·Σ_t |n·A_t|` over the doubled area vectors (the shadow is covered twice, by the
+    /// triangles facing `n` and by those facing away), in lanes of [`LANES`] triangles.
+    pub fn shadow(&self, n: DVec3) -> f64 {
+        let [x, y, z] = &self.columns;
+        let sums: [f64; LANES] = crate::simd::plain(
+            #[inline(always)]
+            || {
+                let mut sums = [0.0; LANES];
+                for g in 0..x.len() {
+                    for j in 0..LANES {
+                        sums[j] += (x[g][j] * n.x + y[g][j] * n.y + z[g][j] * n.z).abs();
+                    }
+                }
+                sums
+            },
+        );
+        sums.iter().sum::<f64>() / 4.0
     }
 
     /// The vertex of greatest projection on `d`, found by climbing from vertex `from` to a
@@ -123,13 +162,22 @@ impl Solid {
     /// column of a nearby frame), which are updated: a box's size near a known one in a few
     /// steps each.
     pub fn extents(&self, frame: &DMat3, from: &mut [usize; 6]) -> DVec3 {
-        DVec3::from_array([0, 1, 2].map(|k| {
-            let axis = frame.col(k);
-            from[2 * k] = self.extreme(-axis, from[2 * k]);
-            from[2 * k + 1] = self.extreme(axis, from[2 * k + 1]);
-            let [lo, hi] = [from[2 * k], from[2 * k + 1]].map(|i| self.vertices[i].dot(axis));
-            (hi - lo).max(0.0)
-        }))
+        let [x, y, z] = [0, 1, 2].map(|k| {
+            let mut ends = [from[2 * k], from[2 * k + 1]];
+            let extent = self.extent(frame.col(k), &mut ends);
+            [from[2 * k], from[2 * k + 1]] = ends;
+            extent
+        });
+        DVec3::new(x, y, z)
+    }
+
+    /// The extent `max − min` of the hull along `axis`, by two climbs from the vertices in
+    /// `from` (the lowest and the highest along a nearby axis), which are updated.
+    pub fn extent(&self, axis: DVec3, from: &mut [usize; 2]) -> f64 {
+        from[0] = self.extreme(-axis, from[0]);
+        from[1] = self.extreme(axis, from[1]);
+        let [lo, hi] = from.map(|i| self.vertices[i].dot(axis));
+        (hi - lo).max(0.0)
     }
 
     /// The vertices on the hull's outline seen along the unit direction `n`, some more than
@@ -139,9 +187,10 @@ impl Solid {
     ///
     /// A triangle faces `n` when `n·A > 2^-40·s` for its area vector `A` and its scale `s`
     /// (the `f64` value of `n·A` is within a few `u = 2^-53` of `s`, so a triangle that faces
-    /// `n` really does), and is *edge-on* when `|n·A| <= 2^-40·s`. The outline holds the ends
-    /// of each edge between a triangle that faces `n` and one that does not, and every
-    /// vertex of an edge-on triangle.
+    /// `n` really does), and is *edge-on* when `|n·A| <= 2^-40·s`. The outline holds the first
+    /// vertex of each edge that leaves a triangle facing `n` for one that does not (these
+    /// edges bound the triangles facing `n`, so they form closed cycles, and each of their
+    /// vertices starts one), and every vertex of an edge-on triangle.
     ///
     /// *Proof* that it holds each corner vertex `v`: some direction `d ⟂ n` is maximised at
     /// `v`, so `d` is in the cone spanned by the normals of the triangles around `v`. They
@@ -149,20 +198,34 @@ impl Solid {
     /// `n·d < 0`): so either one is edge-on, or both kinds meet at an edge at `v` (the
     /// triangles around `v` form a cycle).
     pub fn outline(&self, n: DVec3) -> Vec<usize> {
-        let band = |t: usize| pow2(-40) * self.scales[t];
-        let faces: Vec<bool> = (0..self.triangles.len())
-            .map(|t| n.dot(self.areas[t]) > band(t))
-            .collect();
+        // Each triangle's side in lanes: 1 facing `n`, 0 edge-on, -1 facing away.
+        let [x, y, z] = &self.columns;
+        let sides: Vec<[i8; LANES]> = crate::simd::plain(
+            #[inline(always)]
+            || {
+                (0..x.len())
+                    .map(|g| {
+                        let mut side = [0; LANES];
+                        for j in 0..LANES {
+                            let h = x[g][j] * n.x + y[g][j] * n.y + z[g][j] * n.z;
+                            let band = self.bands[g][j];
+                            side[j] = i8::from(h > band) - i8::from(h < -band);
+                        }
+                        side
+                    })
+                    .collect()
+            },
+        );
+        let side = |t: usize| sides[t / LANES][t % LANES];
         let mut outline = Vec::new();
         for (t, tri) in self.triangles.iter().enumerate() {
-            if faces[t] {
-                for k in 0..3 {
-                    if !faces[self.neighbors[t][k]] {
-                        outline.extend([tri[k], tri[(k + 1) % 3]]);
-                    }
+            match side(t) {
+                1 => {
+                    let across = self.neighbors[t].map(|g| side(g) != 1);
+                    outline.extend((0..3).filter(|&k| across[k]).map(|k| tri[k]));
                 }
-            } else if n.dot(self.areas[t]).abs() <= band(t) {
-                outline.extend(tri);
+                0 => outline.extend(tri),
+                _ => {}
             }
         }
         outline
@@ -367,6 +430,8 @@ struct Quickhull<'a> {
     last: Vec<usize>,
     /// The point after each point in its face's outside set.
     next: Vec<usize>,
+    /// Dead faces' slots, for new faces.
+    free: Vec<usize>,
     /// `visible[f] == step` marks the faces that the current eye sees.
     visible: Vec<usize>,
     step: usize,
@@ -388,9 +453,10 @@ impl<'a> Quickhull<'a> {
         } else {
             (b, c)
         };
-        // Room for the faces of a typical run (each step kills the faces it sees), so that
-        // small hulls never grow their vectors.
-        let faces = (8 * points.len() + 8).min(1 << 12);
+        // Room for every face: dead faces' slots are reused, and a hull of `n` points has
+        // at most `2n − 4` faces (a step's new faces take the slots of those it kills,
+        // at least one, before more).
+        let faces = 2 * points.len() + 8;
         let mut hull = Self {
             points,
             faces: Vec::with_capacity(faces),
@@ -400,6 +466,7 @@ impl<'a> Quickhull<'a> {
             first: Vec::with_capacity(faces),
             last: Vec::with_capacity(faces),
             next: vec![NONE; points.len()],
+            free: Vec::new(),
             visible: Vec::with_capacity(faces),
             step: 0,
             seen: Vec::new(),
@@ -424,10 +491,22 @@ impl<'a> Quickhull<'a> {
         hull
     }
 
+    /// A new face, in the slot of a dead one when there is one (so the vectors stay the
+    /// size of the hull, not of every face ever made).
     fn add_face(&mut self, face: [usize; 3]) -> usize {
-        let id = self.faces.len();
         let [a, b, c] = face.map(|i| self.points[i]);
-        self.planes.push(Plane::new(a, b, c));
+        let plane = Plane::new(a, b, c);
+        if let Some(id) = self.free.pop() {
+            self.planes[id] = plane;
+            self.faces[id] = face;
+            self.neighbors[id] = [id; 3];
+            self.alive[id] = true;
+            (self.first[id], self.last[id]) = (NONE, NONE);
+            self.visible[id] = 0;
+            return id;
+        }
+        let id = self.faces.len();
+        self.planes.push(plane);
         self.faces.push(face);
         self.neighbors.push([id; 3]);
         self.alive.push(true);
@@ -506,6 +585,7 @@ impl<'a> Quickhull<'a> {
                 }
                 self.alive[f] = false;
                 orphans.extend(self.outside(f));
+                self.free.push(f);
             }
             // A cone of new faces `(u, v, eye)`: across `(u, v)` the horizon face, across
             // `(v, eye)` the new face that starts at `v`, across `(eye, u)` the one that ends

@@ -476,19 +476,12 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// Normals are taken in order of that bound, and once it exceeds the `keep`-th best
 /// volume found (with a relative margin of `10^-9` for its rounding), none left can enter.
 fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> Vec<(f64, DMat3)> {
-    let (vertices, areas) = (&hull.vertices, &hull.areas);
+    let vertices = &hull.vertices;
+    // Each normal's ends start the climbs of the next.
+    let mut ends = [0; 2];
     let mut bounded: Vec<(f64, DVec3)> = face_normals(hull, normals)
         .into_iter()
-        .map(|n| {
-            let (lo, hi) = vertices
-                .iter()
-                .map(|p| p.dot(n))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                    (lo.min(q), hi.max(q))
-                });
-            let projected: f64 = areas.iter().map(|a| a.dot(n).abs()).sum::<f64>() / 4.0;
-            ((hi - lo) * projected, n)
-        })
+        .map(|n| (hull.extent(n, &mut ends) * hull.shadow(n), n))
         .collect();
     bounded.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Vec<(f64, DMat3)> = Vec::with_capacity(keep + 1);
@@ -511,24 +504,34 @@ fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> 
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
 /// `most` of them.
 fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
-    // Each face's direction key, twice its area and its unit normal, by key (a stable sort:
-    // the first face of a direction gives its normal).
-    let mut faces: Vec<([i64; 3], f64, DVec3)> = hull
-        .areas
-        .iter()
-        .filter_map(|&n| {
-            let unit = n.try_normalize()?;
+    let areas = &hull.areas;
+    // Each face's direction key and index, by key then index: the first face of a
+    // direction gives its normal.
+    let mut faces: Vec<([i64; 3], usize)> = (0..areas.len())
+        .filter_map(|t| {
+            let unit = areas[t].try_normalize()?;
             let key = (unit * f64::from(1u32 << 24)).round().as_i64vec3();
-            Some((key.to_array(), n.length(), unit))
+            Some((key.to_array(), t))
         })
         .collect();
-    faces.sort_by_key(|f| f.0);
-    let mut normals: Vec<(f64, DVec3)> = faces
+    faces.sort_unstable();
+    let mut normals: Vec<(f64, [i64; 3], DVec3)> = faces
         .chunk_by(|a, b| a.0 == b.0)
-        .map(|run| (run.iter().map(|f| f.1).sum(), run[0].2))
+        .map(|run| {
+            let area = run.iter().map(|&(_, t)| areas[t].length()).sum();
+            (area, run[0].0, areas[run[0].1].normalize())
+        })
         .collect();
-    normals.sort_by(|a, b| b.0.total_cmp(&a.0));
-    normals.into_iter().take(most).map(|(_, n)| n).collect()
+    // Largest first, ties in key order; only the first `most` are sorted.
+    let order = |a: &(f64, [i64; 3], DVec3), b: &(f64, [i64; 3], DVec3)| {
+        b.0.total_cmp(&a.0).then(a.1.cmp(&b.1))
+    };
+    if normals.len() > most {
+        normals.select_nth_unstable_by(most, order);
+        normals.truncate(most);
+    }
+    normals.sort_unstable_by(order);
+    normals.into_iter().map(|(_, _, n)| n).collect()
 }
 
 /// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
