@@ -34,18 +34,17 @@ pub(crate) enum Hull {
 }
 
 /// A solid hull: its vertices and its outward (counter-clockwise) triangles into them,
-/// with their neighbours and area vectors.
+/// with their edges, area vectors and each vertex's neighbours.
 #[derive(Clone, Debug)]
 pub(crate) struct Solid {
     /// The hull vertices.
     pub vertices: Vec<DVec3>,
     /// Triangles, as indices into `vertices`.
     pub triangles: Vec<[usize; 3]>,
-    /// `neighbors[t][k]`: the triangle across edge `k` of triangle `t`, from its vertex `k`
-    /// to its vertex `k + 1`.
-    pub neighbors: Vec<[usize; 3]>,
     /// Each triangle's doubled area vector `(b − a) × (c − a)`, outward.
     pub areas: Vec<DVec3>,
+    /// Each edge once, with its two triangles.
+    edges: Vec<Edge>,
     /// The vertices joined to vertex `v` by an edge: `links[starts[v]..starts[v + 1]]`.
     starts: Vec<usize>,
     links: Vec<usize>,
@@ -56,12 +55,21 @@ pub(crate) struct Solid {
     bands: Vec<[f64; LANES]>,
 }
 
+/// An edge of a solid hull: its two triangles, and its first vertex as it runs in each
+/// (the triangles run it in opposite directions).
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    faces: [usize; 2],
+    tails: [usize; 2],
+}
+
 /// Triangles per lane group of [`Solid::shadow`] and [`Solid::outline`].
 const LANES: usize = 4;
 
 impl Solid {
-    /// The hull from its vertices, triangles and neighbours.
-    fn new(vertices: Vec<DVec3>, triangles: Vec<[usize; 3]>, neighbors: Vec<[usize; 3]>) -> Self {
+    /// The hull from its vertices, triangles and their neighbours (`neighbors[t][k]`: the
+    /// triangle across edge `k` of triangle `t`, from its vertex `k` to its vertex `k + 1`).
+    fn new(vertices: Vec<DVec3>, triangles: Vec<[usize; 3]>, neighbors: &[[usize; 3]]) -> Self {
         let (areas, scales): (Vec<DVec3>, Vec<f64>) = triangles
             .iter()
             .map(|t| {
@@ -104,11 +112,19 @@ impl Solid {
         };
         let columns = [0, 1, 2].map(|k| lanes(&|t| areas[t][k]));
         let bands = lanes(&|t| pow2(-40) * scales[t]);
+        let edges = (0..triangles.len())
+            .flat_map(|t| (0..3).map(move |k| (t, k)))
+            .filter(|&(t, k)| t < neighbors[t][k])
+            .map(|(t, k)| Edge {
+                faces: [t, neighbors[t][k]],
+                tails: [triangles[t][k], triangles[t][(k + 1) % 3]],
+            })
+            .collect();
         Self {
             vertices,
             triangles,
-            neighbors,
             areas,
+            edges,
             starts,
             links,
             columns,
@@ -216,16 +232,18 @@ impl Solid {
                     .collect()
             },
         );
-        let side = |t: usize| sides[t / LANES][t % LANES];
+        let sides = &sides.as_flattened()[..self.triangles.len()];
+        // Few edges are on the rim and few triangles edge-on: both tests are predictable.
         let mut outline = Vec::new();
-        for (t, tri) in self.triangles.iter().enumerate() {
-            match side(t) {
-                1 => {
-                    let across = self.neighbors[t].map(|g| side(g) != 1);
-                    outline.extend((0..3).filter(|&k| across[k]).map(|k| tri[k]));
-                }
-                0 => outline.extend(tri),
-                _ => {}
+        for edge in &self.edges {
+            let [a, b] = edge.faces.map(|t| sides[t] == 1);
+            if a != b {
+                outline.push(edge.tails[usize::from(b)]);
+            }
+        }
+        for (t, &side) in sides.iter().enumerate() {
+            if side == 0 {
+                outline.extend(self.triangles[t]);
             }
         }
         outline
@@ -659,11 +677,11 @@ impl<'a> Quickhull<'a> {
                 })
             })
             .collect();
-        let neighbors = alive
+        let neighbors: Vec<[usize; 3]> = alive
             .iter()
             .map(|&f| self.neighbors[f].map(|g| number[g]))
             .collect();
-        Hull::Solid(Box::new(Solid::new(vertices, triangles, neighbors)))
+        Hull::Solid(Box::new(Solid::new(vertices, triangles, &neighbors)))
     }
 }
 
