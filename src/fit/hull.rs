@@ -357,10 +357,18 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     }
     let mut extremal: Vec<usize> = seed.to_vec();
     for n in DIRECTIONS.map(DVec3::from_array) {
-        let key = |&i: &usize| points[i].dot(n);
-        let by = |a: &usize, b: &usize| key(a).total_cmp(&key(b));
-        extremal.extend((0..points.len()).min_by(by));
-        extremal.extend((0..points.len()).max_by(by));
+        // The first least and the last greatest projection.
+        let (mut lo, mut hi) = ((f64::INFINITY, 0), (f64::NEG_INFINITY, 0));
+        for (i, p) in points.iter().enumerate() {
+            let h = p.dot(n);
+            if h < lo.0 {
+                lo = (h, i);
+            }
+            if h >= hi.0 {
+                hi = (h, i);
+            }
+        }
+        extremal.extend([lo.1, hi.1]);
     }
     extremal.sort_unstable();
     extremal.dedup();
@@ -380,9 +388,20 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
             Plane::new(a, b, c)
         })
         .collect();
-    let inside = |p: DVec3| faces.iter().all(|f| f.side(p) == Some(false));
+    // The points in coordinate columns, each face tested on all of them in lanes.
+    let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).collect::<Vec<f64>>());
+    let inside = crate::simd::plain(
+        #[inline(always)]
+        || {
+            let mut inside = vec![true; points.len()];
+            for face in &faces {
+                face.below(&x, &y, &z, &mut inside);
+            }
+            inside
+        },
+    );
     (0..points.len())
-        .filter(|&i| extremal.binary_search(&i).is_ok() || !inside(points[i]))
+        .filter(|&i| extremal.binary_search(&i).is_ok() || !inside[i])
         .collect()
 }
 
@@ -407,6 +426,19 @@ impl Plane {
             a,
             n: ab.cross(ac),
             pad: pow2(-40) * ab.abs().element_sum() * ac.abs().element_sum(),
+        }
+    }
+
+    /// Clears `inside[i]` unless the point `(x[i], y[i], z[i])` lies below the plane by
+    /// more than the pad ([`Plane::side`] gives `Some(false)`): plain array code, for lanes.
+    #[inline(always)]
+    fn below(&self, x: &[f64], y: &[f64], z: &[f64], inside: &mut [bool]) {
+        let Self { a, n, pad } = *self;
+        for (i, inside) in inside.iter_mut().enumerate() {
+            let d = [x[i] - a.x, y[i] - a.y, z[i] - a.z];
+            let height = n.x * d[0] + n.y * d[1] + n.z * d[2];
+            let reach = pad * (d[0].abs() + d[1].abs() + d[2].abs());
+            *inside &= height < -reach;
         }
     }
 
