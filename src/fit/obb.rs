@@ -308,8 +308,10 @@ fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
 /// hull of 26 points has at most 48 faces).
 const FAST_NORMALS: usize = 48;
 /// How many of them get their rectangle in the fast fit: those of least bound (see
-/// [`face_frames`]). On the test meshes the best face frame is always among the first 8,
-/// and a rectangle costs as much as the bounds of every normal.
+/// [`face_frames`]). On the test meshes the best face frame is always among the first 8
+/// (the first 4 miss the teapot's: 1.18× the tight box instead of 1.05×), and the bound
+/// rarely rules out more: a shadow's rectangle exceeds its area by up to `4/π` on round
+/// shapes.
 const FAST_RECTANGLES: usize = 8;
 
 /// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
