@@ -307,32 +307,36 @@ fn check_targets(
     let best_obb = obb.iter().map(|r| r.volume).fold(f64::INFINITY, f64::min);
     let per_100k =
         |method: &str| time_of(obb, method).as_secs_f64() * 1e3 * 1e5 / points.len() as f64;
-    // The time targets are per 100k vertices: on a mesh of a few thousand, a fit's fixed
-    // per-call cost (hulls and rectangles of a few dozen points) dominates the scaled
-    // figure, so they are judged on the meshes of at least 10k vertices only.
-    let large = points.len() >= 10_000;
-    let timed = |ms: f64, limit: f64| {
-        if large {
-            (
-                format!("{ms:.3} ms per 100k vertices (<= {limit})"),
-                ms <= limit,
-            )
-        } else {
-            (
-                format!("{ms:.3} ms per 100k vertices (time judged on >= 10k vertices only)"),
-                true,
-            )
-        }
+    // The time targets are per 100k vertices (issue 48's): the tight fit at most 25 ms on
+    // the real meshes and 100 ms on the 100k torus, the fast fit at most 0.6 ms on meshes
+    // of at least 3k vertices. On the small procedural meshes a fit's fixed per-call cost
+    // dominates the scaled figure: their times are not judged.
+    let timed = |ms: f64, limit: Option<f64>| match limit {
+        Some(limit) => (
+            format!("{ms:.3} ms per 100k vertices (<= {limit})"),
+            ms <= limit,
+        ),
+        None => (
+            format!("{ms:.3} ms per 100k vertices (time not judged on this mesh)"),
+            true,
+        ),
     };
+    let real = matches!(name, "spot" | "teapot");
+    let tight_limit = if real {
+        Some(25.0)
+    } else {
+        (points.len() >= 10_000).then_some(100.0)
+    };
+    let fast_limit = (points.len() >= 3_000).then_some(0.6);
     let tight = volume_of(obb, "Tight") / best_obb;
-    let (tight_time, tight_fast_enough) = timed(per_100k("Tight"), 25.0);
+    let (tight_time, tight_fast_enough) = timed(per_100k("Tight"), tight_limit);
     out.push(Target {
         text: format!("{name}: Tight OBB / best = {tight:.4} (<= 1.01), {tight_time}"),
         met: tight <= 1.01 && tight_fast_enough,
     });
     let fast = volume_of(obb, "Fast");
     let floor = volume_of(obb, "PCA axes, midrange center").min(volume_of(obb, "AABB"));
-    let (fast_time, fast_enough) = timed(per_100k("Fast"), 0.5);
+    let (fast_time, fast_enough) = timed(per_100k("Fast"), fast_limit);
     out.push(Target {
         text: format!(
             "{name}: Fast OBB / best = {:.4} (<= 1.15), / min(PCA midrange, AABB) = {:.7} (<= 1 + 1e-6), {fast_time}",
