@@ -213,10 +213,11 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         while let Some((ra, rb, split_a)) = stack.pop() {
             if split_a {
                 let (cb, eb) = box_b(rb);
+                let fixed = rel.fixed_b(cb, eb);
                 for child in ha.layout.children(ra.index()).into_iter().rev() {
                     let (ca, ea) = box_a(child);
                     stats.node_pairs += 1;
-                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                    if !fixed.overlaps(ca, ea) {
                         continue;
                     }
                     if child.is_primitive() && rb.is_primitive() {
@@ -231,10 +232,11 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                 }
             } else {
                 let (ca, ea) = box_a(ra);
+                let fixed = rel.fixed_a(ca, ea);
                 for child in hb.layout.children(rb.index()).into_iter().rev() {
                     let (cb, eb) = box_b(child);
                     stats.node_pairs += 1;
-                    if !rel.overlaps_ce(ca, ea, cb, eb) {
+                    if !fixed.overlaps(cb, eb) {
                         continue;
                     }
                     if child.is_primitive() && ra.is_primitive() {

@@ -295,6 +295,37 @@ impl Relative {
         !d.cmpgt(r).any()
     }
 
+    /// [`Relative::overlaps_ce`] for boxes of `A` against one box of `B` held fixed: the
+    /// half of `A`'s axes that reads only `B`'s box (`M·c_b + t` and `|M|·e_b`), computed
+    /// once. [`FixedB::overlaps`] then gives the same bits as `overlaps_ce`.
+    #[inline(always)]
+    pub(crate) fn fixed_b(&self, cb: Vec3A, eb: Vec3A) -> FixedB<'_> {
+        let [c0, c1, c2] = self.cols;
+        let [a0, a1, a2] = self.abs_cols;
+        FixedB {
+            rel: self,
+            placed: c0 * cb.x + c1 * cb.y + c2 * cb.z + self.t32,
+            reach: a0 * eb.x + a1 * eb.y + a2 * eb.z,
+            cb,
+            eb,
+        }
+    }
+
+    /// [`Relative::overlaps_ce`] for boxes of `B` against one box of `A` held fixed: the
+    /// half of `B`'s axes that reads only `A`'s box, computed once.
+    #[inline(always)]
+    pub(crate) fn fixed_a(&self, ca: Vec3A, ea: Vec3A) -> FixedA<'_> {
+        let [r0, r1, r2] = self.rows;
+        let [b0, b1, b2] = self.abs_rows;
+        FixedA {
+            rel: self,
+            placed: r0 * ca.x + r1 * ca.y + r2 * ca.z + self.t_b,
+            reach: b0 * ea.x + b1 * ea.y + b2 * ea.z,
+            ca,
+            ea,
+        }
+    }
+
     /// The same test on `min`/`max` boxes (`a` in `A`'s frame, `b` in `B`'s), read back as
     /// center and extent with the rounding the pad covers; for the reaches given to
     /// [`Relative::new`]. An empty box never overlaps; NaN faces always do (conservative).
@@ -400,4 +431,64 @@ fn pad(
         + frob * sqrt(3.0) * rb
         + 12.0 * U * (1.0 + mm) * (ra + rb + tt);
     round_up(sum * (1.0 + pow2(-20)))
+}
+
+/// A box of `B` held fixed for [`Relative::overlaps_ce`] against boxes of `A`.
+pub(crate) struct FixedB<'a> {
+    rel: &'a Relative,
+    /// `M·c_b + t` in `f32`, summed as in `overlaps_ce`.
+    placed: Vec3A,
+    /// `|M|·e_b`, summed as in `overlaps_ce`.
+    reach: Vec3A,
+    cb: Vec3A,
+    eb: Vec3A,
+}
+
+impl FixedB<'_> {
+    /// `overlaps_ce(ca, ea, cb, eb)`, the same operations in the same order.
+    #[inline(always)]
+    pub(crate) fn overlaps(&self, ca: Vec3A, ea: Vec3A) -> bool {
+        let rel = self.rel;
+        let pad = Vec3A::splat(rel.pad);
+        let d = (self.placed - ca).abs();
+        let r = self.reach + ea + pad;
+        if d.cmpgt(r).any() {
+            return false;
+        }
+        let [r0, r1, r2] = rel.rows;
+        let [b0, b1, b2] = rel.abs_rows;
+        let d = (r0 * ca.x + r1 * ca.y + r2 * ca.z + rel.t_b - self.cb).abs();
+        let r = b0 * ea.x + b1 * ea.y + b2 * ea.z + self.eb + pad;
+        !d.cmpgt(r).any()
+    }
+}
+
+/// A box of `A` held fixed for [`Relative::overlaps_ce`] against boxes of `B`.
+pub(crate) struct FixedA<'a> {
+    rel: &'a Relative,
+    /// `Mᵀ·c_a + t_b` in `f32`, summed as in `overlaps_ce`.
+    placed: Vec3A,
+    /// `|Mᵀ|·e_a`, summed as in `overlaps_ce`.
+    reach: Vec3A,
+    ca: Vec3A,
+    ea: Vec3A,
+}
+
+impl FixedA<'_> {
+    /// `overlaps_ce(ca, ea, cb, eb)`, the same operations in the same order.
+    #[inline(always)]
+    pub(crate) fn overlaps(&self, cb: Vec3A, eb: Vec3A) -> bool {
+        let rel = self.rel;
+        let pad = Vec3A::splat(rel.pad);
+        let [c0, c1, c2] = rel.cols;
+        let [a0, a1, a2] = rel.abs_cols;
+        let d = (c0 * cb.x + c1 * cb.y + c2 * cb.z + rel.t32 - self.ca).abs();
+        let r = a0 * eb.x + a1 * eb.y + a2 * eb.z + self.ea + pad;
+        if d.cmpgt(r).any() {
+            return false;
+        }
+        let d = (self.placed - cb).abs();
+        let r = self.reach + eb + pad;
+        !d.cmpgt(r).any()
+    }
 }
