@@ -492,3 +492,42 @@ impl FixedA<'_> {
         !d.cmpgt(r).any()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Quat;
+
+    /// A box held fixed gives `overlaps_ce`'s answer on every pair, either side fixed.
+    #[test]
+    fn a_fixed_box_gives_the_same_answers() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let pose = |x: f32, y: f32, z: f32, w: f32| Rigid3 {
+            rotation: Quat::from_xyzw(x, y, z, w).normalize(),
+            translation: Vec3A::new(x, y, z) * 0.5,
+        };
+        let (mut same, mut apart) = (0, 0);
+        for _ in 0..200 {
+            let pa = pose(next(), next(), next(), next());
+            let pb = pose(next(), next(), next(), next());
+            let rel = Relative::new(&pa, 4.0, &pb, 4.0, 0.0).expect("a finite pose");
+            let mut corner = || Vec3A::new(next(), next(), next());
+            let (ca, cb) = (corner(), corner());
+            let (ea, eb) = (corner().abs(), corner().abs());
+            let expected = rel.overlaps_ce(ca, ea, cb, eb);
+            assert_eq!(rel.fixed_b(cb, eb).overlaps(ca, ea), expected);
+            assert_eq!(rel.fixed_a(ca, ea).overlaps(cb, eb), expected);
+            if expected { same += 1 } else { apart += 1 }
+        }
+        assert!(
+            same > 20 && apart > 20,
+            "both answers drawn: {same} {apart}"
+        );
+    }
+}
