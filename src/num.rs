@@ -79,3 +79,16 @@ pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
     #[cfg(not(feature = "std"))]
     return libm::sincosf(x);
 }
+
+/// A test's fixed-seed stream of uniform `f64` values in `[-1, 1)`: xorshift64 (13, 7, 17),
+/// its top 53 bits.
+#[cfg(test)]
+pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}

@@ -762,13 +762,7 @@ mod tests {
     /// one on a segment between two of them) is the hull of all its points.
     #[test]
     fn the_extremal_filter_keeps_every_vertex() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = crate::num::uniform(0x2545_f491_4f6c_dd1d);
         let mut points: Vec<DVec3> = (0..2000)
             .map(|k| {
                 let p = DVec3::new(next(), next(), next());
@@ -804,13 +798,7 @@ mod tests {
     /// highest vertex along each direction.
     #[test]
     fn the_outline_casts_the_hull_shadow_and_the_climbs_reach_the_top() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
         let cube: Vec<DVec3> = (0..27)
             .map(|k| DVec3::new((k % 3) as f64, (k / 3 % 3) as f64, (k / 9) as f64))
             .collect();

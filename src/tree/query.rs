@@ -213,11 +213,12 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         while let Some((ra, rb, split_a)) = stack.pop() {
             if split_a {
                 let (cb, eb) = box_b(rb);
-                let fixed = rel.fixed_b(cb, eb);
+                // `B`'s box on `A`'s axes, once for both children.
+                let b_on_a = rel.on_a(cb, eb);
                 for child in ha.layout.children(ra.index()).into_iter().rev() {
                     let (ca, ea) = box_a(child);
                     stats.node_pairs += 1;
-                    if !fixed.overlaps(ca, ea) {
+                    if rel.apart(&b_on_a, ca, ea) || rel.apart(&rel.on_b(ca, ea), cb, eb) {
                         continue;
                     }
                     if child.is_primitive() && rb.is_primitive() {
@@ -232,11 +233,11 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                 }
             } else {
                 let (ca, ea) = box_a(ra);
-                let fixed = rel.fixed_a(ca, ea);
+                let a_on_b = rel.on_b(ca, ea);
                 for child in hb.layout.children(rb.index()).into_iter().rev() {
                     let (cb, eb) = box_b(child);
                     stats.node_pairs += 1;
-                    if !fixed.overlaps(cb, eb) {
+                    if rel.apart(&rel.on_a(cb, eb), ca, ea) || rel.apart(&a_on_b, cb, eb) {
                         continue;
                     }
                     if child.is_primitive() && ra.is_primitive() {

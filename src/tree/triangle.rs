@@ -456,13 +456,7 @@ mod tests {
     /// pairs a hair apart, and empty lanes.
     #[test]
     fn the_lane_filter_agrees_with_the_exact_test() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
         let one_sided = |s: Option<[i8; 3]>| s.is_some_and(aside);
         let (mut rejected, mut met, mut unsure) = (0, 0, 0);
         for round in 0..64 {
