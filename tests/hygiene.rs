@@ -17,7 +17,7 @@ use bvkit_support::mxcsr;
 use bvkit_support::trimesh;
 
 use bvkit::LargeWorld;
-use bvkit::tree::{AabbTree, Quantized, Query, TriMesh};
+use bvkit::tree::{AabbTree, Paired, Quantized, Query, TriMesh};
 use bvkit::{
     Aabb2, Aabb3, Active, Backend, Batch, Block8, BoundingVolume, Capsule, Fit, LargeRigid3,
     Margin, Method, Moved, Obb3, Rigid2, Rigid3, Rounding, Similarity3, Soa, Sphere, Swept,
@@ -417,6 +417,7 @@ fn tree_queries_raise_no_subnormal_flag() {
     let a = TriMesh::new(va, ia).unwrap();
     let b = TriMesh::new(vb, ib).unwrap();
     let (aq, bq) = (a.with_layout::<Quantized>(), b.with_layout::<Quantized>());
+    let (aw, bw) = (a.with_layout::<Paired>(), b.with_layout::<Paired>());
     let boxes: Vec<Aabb3> = scene(6)
         .boxes
         .iter()
@@ -434,6 +435,9 @@ fn tree_queries_raise_no_subnormal_flag() {
             core::hint::black_box(q.intersects());
             core::hint::black_box(q.overlapping_triangles());
             let q = Query::new(&aq, pa, &bq, pb).unwrap();
+            core::hint::black_box(q.overlapping_triangles());
+            let q = Query::new(&aw, pa, &bw, pb).unwrap();
+            core::hint::black_box(q.intersects());
             core::hint::black_box(q.overlapping_triangles());
             let (sa, sb) = (Similarity3::from(pa), Similarity3::from(pb));
             let q = Query::similarity(&a, sa, &b, Similarity3 { scale: 1.5, ..sb }).unwrap();

@@ -11,7 +11,7 @@ use bvkit_support::trimesh;
 use std::ops::ControlFlow;
 
 use bvkit::tree::{
-    AabbTree, Compact, MeshError, Object, Quantized, Query, QueryError, Relative, TriMesh,
+    AabbTree, Compact, MeshError, Object, Paired, Quantized, Query, QueryError, Relative, TriMesh,
     triangles_distance_sq, triangles_intersect,
 };
 use bvkit::{Aabb3, Rigid3, Similarity3};
@@ -213,8 +213,13 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
             AabbTree::<Quantized>::build(&ba).unwrap(),
             AabbTree::<Quantized>::build(&bb).unwrap(),
         );
+        let (wa, wb) = (
+            AabbTree::<Paired>::build(&ba).unwrap(),
+            AabbTree::<Paired>::build(&bb).unwrap(),
+        );
         let pairs = ta.query(pa, &tb, pb).unwrap().leaf_pairs();
         let qpairs = qa.query(pa, &qb, pb).unwrap().leaf_pairs();
+        let wpairs = wa.query(pa, &wb, pb).unwrap().leaf_pairs();
         let rel = Relative::new(&pa, 1.0, &pb, 1.0, 0.0).unwrap();
         let mut exact_count = 0;
         for (i, a) in ba.iter().enumerate() {
@@ -224,6 +229,7 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
                     let p = (i as u32, j as u32);
                     assert!(pairs.contains(&p), "compact tree culled {p:?}");
                     assert!(qpairs.contains(&p), "quantized tree culled {p:?}");
+                    assert!(wpairs.contains(&p), "paired tree culled {p:?}");
                 }
             }
         }
@@ -401,9 +407,11 @@ fn overlapping_triangles_equal_brute_force() {
     for (na, va, ia) in &meshes {
         let a = TriMesh::new(va.clone(), ia.clone()).unwrap();
         let aq = a.with_layout::<Quantized>();
+        let aw = a.with_layout::<Paired>();
         for (nb, vb, ib) in &meshes {
             let b = TriMesh::new(vb.clone(), ib.clone()).unwrap();
             let bq = b.with_layout::<Quantized>();
+            let bw = b.with_layout::<Paired>();
             for (k, (pa, pb)) in trimesh::poses(12, 0.8, 1)
                 .into_iter()
                 .zip(trimesh::poses(12, 0.8, 2))
@@ -438,6 +446,18 @@ fn overlapping_triangles_equal_brute_force() {
                     .overlapping_triangles();
                 quant.sort_unstable();
                 assert_eq!(quant, expected, "quantized {na} vs {nb}, pose {k}");
+                let mut paired = Query::new(&aw, pa, &bw, pb)
+                    .and_then(|q| q.with_tolerance(tolerance))
+                    .unwrap()
+                    .overlapping_triangles();
+                paired.sort_unstable();
+                assert_eq!(paired, expected, "paired {na} vs {nb}, pose {k}");
+                let mut mixed = Query::new(&a, pa, &bw, pb)
+                    .and_then(|q| q.with_tolerance(tolerance))
+                    .unwrap()
+                    .overlapping_triangles();
+                mixed.sort_unstable();
+                assert_eq!(mixed, expected, "compact × paired {na} vs {nb}, pose {k}");
                 let mut cross = q.with_cross_axes_near_leaves(true).overlapping_triangles();
                 cross.sort_unstable();
                 assert_eq!(cross, expected, "cross axes {na} vs {nb}, pose {k}");
@@ -479,8 +499,16 @@ fn visitor_stops_early() {
 fn first_contact_is_the_first_pair_in_descent_order() {
     let (v, t) = trimesh::torus(1.0, 0.3, 40, 25);
     let a = TriMesh::new(v, t).unwrap();
+    let w = a.with_layout::<Paired>();
     let (mut hits, mut misses) = (0, 0);
     for (k, pose) in trimesh::poses(40, 1.2, 21).into_iter().enumerate() {
+        let qw = w.query(Rigid3::IDENTITY, &w, pose).unwrap();
+        let all = qw.overlapping_triangles();
+        assert_eq!(
+            qw.first_contact().0,
+            all.first().copied(),
+            "paired, pose {k}"
+        );
         let q = a.query(Rigid3::IDENTITY, &a, pose).unwrap();
         let all = q.overlapping_triangles();
         let (first, stats) = q.first_contact();
@@ -510,6 +538,8 @@ fn layouts_fit_their_budgets() {
     assert!(a.tree_bytes() <= 32 * n, "{}", a.tree_bytes());
     let q = a.with_layout::<Quantized>();
     assert!(q.tree_bytes() <= 20 * n, "{}", q.tree_bytes());
+    let w = a.with_layout::<Paired>();
+    assert!(w.tree_bytes() <= 32 * n, "{}", w.tree_bytes());
     assert_eq!(a.tree_bytes() / 32, n - 1);
     // Deterministic: the same input builds the same tree.
     let b = TriMesh::new(a.vertices().to_vec(), a.triangles().to_vec()).unwrap();
@@ -576,7 +606,8 @@ fn huge_mesh() -> TriMesh {
 fn geometry_reaching_f32_max_reports_contact() {
     let h = huge_mesh();
     let hq = h.with_layout::<Quantized>();
-    assert!(h.reach().is_finite() && hq.reach().is_finite());
+    let hw = h.with_layout::<Paired>();
+    assert!(h.reach().is_finite() && hq.reach().is_finite() && hw.reach().is_finite());
     assert!(h.reach() >= f64::from(f32::MAX));
     assert_eq!(h.triangle(3), None);
     let id = Rigid3::IDENTITY;
@@ -590,6 +621,19 @@ fn geometry_reaching_f32_max_reports_contact() {
         assert_eq!(ours, expected, "{name}");
         assert_eq!(h.intersects(id, &hq, pb), Ok(true), "{name}");
         assert_eq!(hq.intersects(id, &h, pb), Ok(true), "{name}");
+        assert_eq!(hw.intersects(id, &hq, pb), Ok(true), "{name}");
+        let mut paired = Query::new(&hw, id, &hw, pb)
+            .unwrap()
+            .overlapping_triangles();
+        paired.sort_unstable();
+        let expected = brute_force(
+            &hw,
+            &hw,
+            Query::new(&hw, id, &hw, pb).unwrap().relative(),
+            0.0,
+        );
+        assert!(!expected.is_empty(), "{name}");
+        assert_eq!(paired, expected, "paired, {name}");
     }
     // Each triangle meets itself, in both layouts.
     for (i, j) in [(0, 0), (1, 1), (2, 2)] {
@@ -612,10 +656,12 @@ fn geometry_reaching_f32_max_reports_contact() {
     ];
     let t = AabbTree::new(&boxes).unwrap();
     let tq = AabbTree::<Quantized>::build(&boxes).unwrap();
-    assert!(t.reach().is_finite() && tq.reach().is_finite());
+    let tw = AabbTree::<Paired>::build(&boxes).unwrap();
+    assert!(t.reach().is_finite() && tq.reach().is_finite() && tw.reach().is_finite());
     for pairs in [
         t.query(id, &t, id).unwrap().leaf_pairs(),
         tq.query(id, &tq, id).unwrap().leaf_pairs(),
+        tw.query(id, &tw, turned).unwrap().leaf_pairs(),
         t.query(id, &tq, turned).unwrap().leaf_pairs(),
     ] {
         for p in [(0, 0), (0, 2), (2, 0), (1, 1)] {
@@ -714,12 +760,14 @@ fn refit_matches_a_fresh_build() {
     let (v, t) = trimesh::torus(1.0, 0.35, 10, 6);
     let mut a = TriMesh::new(v.clone(), t.clone()).unwrap();
     let mut aq = a.with_layout::<Quantized>();
+    let mut aw = a.with_layout::<Paired>();
     let moved: Vec<Vec3> = v
         .iter()
         .map(|p| *p * Vec3::new(1.3, 0.7, 1.0) + Vec3::new(0.1 * p.z.sin(), 0.0, 0.2))
         .collect();
     a.refit(&moved).unwrap();
     aq.refit(&moved).unwrap();
+    aw.refit(&moved).unwrap();
     let fresh = TriMesh::new(moved, t.clone()).unwrap();
     let other = TriMesh::new(v, t).unwrap();
     for pose in trimesh::poses(8, 0.7, 5) {
@@ -732,11 +780,16 @@ fn refit_matches_a_fresh_build() {
         let mut z = aq
             .overlapping_triangles(Rigid3::IDENTITY, &other, pose)
             .unwrap();
+        let mut w = aw
+            .overlapping_triangles(Rigid3::IDENTITY, &other, pose)
+            .unwrap();
         x.sort_unstable();
         y.sort_unstable();
         z.sort_unstable();
+        w.sort_unstable();
         assert_eq!(x, y);
         assert_eq!(z, y);
+        assert_eq!(w, y);
     }
     let _: &TriMesh<Compact> = &a;
 }
@@ -822,15 +875,20 @@ fn adversarial_builds_find_every_overlap() {
     for boxes in [spaced, far] {
         let compact = AabbTree::new(&boxes).unwrap();
         let quantized = AabbTree::<Quantized>::build(&boxes).unwrap();
+        let paired = AabbTree::<Paired>::build(&boxes).unwrap();
         for (k, pose) in trimesh::poses(2, 0.3, 8).into_iter().enumerate() {
             let c0 = boxes[0].center();
             // B is A turned about A's first box (so that the far boxes still meet).
             let pose = Rigid3::new(pose.rotation, c0 - pose.rotation * c0);
             let q = compact.query(Rigid3::IDENTITY, &compact, pose).unwrap();
-            let (pairs, qpairs) = (
+            let (pairs, qpairs, wpairs) = (
                 q.leaf_pairs(),
                 quantized
                     .query(Rigid3::IDENTITY, &quantized, pose)
+                    .unwrap()
+                    .leaf_pairs(),
+                paired
+                    .query(Rigid3::IDENTITY, &paired, pose)
                     .unwrap()
                     .leaf_pairs(),
             );
@@ -845,6 +903,7 @@ fn adversarial_builds_find_every_overlap() {
                             qpairs.contains(&(i as u32, j as u32)),
                             "quantized, pose {k}"
                         );
+                        assert!(wpairs.contains(&(i as u32, j as u32)), "paired, pose {k}");
                     }
                 }
             }

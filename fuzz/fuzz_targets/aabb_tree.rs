@@ -8,7 +8,7 @@
 
 use bvkit_support::sat;
 
-use bvkit::tree::{AabbTree, Compact, Layout, Quantized};
+use bvkit::tree::{AabbTree, Compact, Layout, Paired, Quantized};
 use bvkit::{Aabb3, Rigid3};
 use bvkit_fuzz::{Floats, query_error_justified};
 use glam::{Quat, Vec3A};
@@ -113,4 +113,5 @@ fuzz_target!(|data: &[u8]| {
     };
     check::<Compact>(&ba, &bb, new.as_deref(), pa, pb);
     check::<Quantized>(&ba, &bb, new.as_deref(), pa, pb);
+    check::<Paired>(&ba, &bb, new.as_deref(), pa, pb);
 });

@@ -7,7 +7,9 @@
 //! query's placed vertices, in every layout, and `intersects` agrees.
 #![no_main]
 
-use bvkit::tree::{Layout, Quantized, Query, TriMesh, triangles_distance_sq, triangles_intersect};
+use bvkit::tree::{
+    Layout, Paired, Quantized, Query, TriMesh, triangles_distance_sq, triangles_intersect,
+};
 use bvkit::{Rigid3, Similarity3};
 use bvkit_fuzz::{Floats, query_error_justified, similarity};
 use glam::Vec3;
@@ -126,10 +128,14 @@ fuzz_target!(|data: &[u8]| {
         }
     }
     let (aq, bq) = (a.with_layout::<Quantized>(), b.with_layout::<Quantized>());
-    // Both layouts find the same pairs. (Near the 2^300 range limit one may err where the
-    // other does not: a quantized tree's reach is a few grid steps larger.)
+    let (aw, bw) = (a.with_layout::<Paired>(), b.with_layout::<Paired>());
+    // The layouts find the same pairs. (Near the 2^300 range limit one may err where
+    // another does not: a quantized tree's reach is a few grid steps larger.)
     let compact = check(&a, &b, pa, pb, tolerance);
     if let (Some(x), Some(y)) = (check(&aq, &bq, pa, pb, tolerance), &compact) {
+        assert_eq!(&x, y);
+    }
+    if let (Some(x), Some(y)) = (check(&aw, &bw, pa, pb, tolerance), &compact) {
         assert_eq!(&x, y);
     }
     // The rigid entry points agree with the similarity query at unit scale.

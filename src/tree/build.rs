@@ -209,6 +209,6 @@ pub(crate) fn node_boxes(
 
 /// A layout over a topology whose primitive `i` has the box `prim(i)`.
 pub(crate) fn layout<L: Store>(children: &[[Ref; 2]], prim: impl Fn(u32) -> PrimBox) -> L {
-    let (min, max) = node_boxes(children, prim);
-    L::from_boxes(children, &min, &max)
+    let (min, max) = node_boxes(children, &prim);
+    L::from_boxes(children, &min, &max, prim)
 }

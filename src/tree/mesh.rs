@@ -86,8 +86,8 @@ impl core::error::Error for MeshError {}
 pub(crate) struct Hierarchy<L> {
     pub layout: L,
     pub root: Ref,
-    /// Every box of the tree (nodes as stored and primitives) lies within `±reach` on every
-    /// axis, to within `2^-52` relative ([`Hierarchy::measure`]).
+    /// Every box of the tree (primitives', and every box as stored) lies within `±reach` on
+    /// every axis, to within `2^-52` relative ([`Hierarchy::measure`]).
     pub reach: f64,
 }
 
@@ -120,32 +120,18 @@ impl<L: Layout> Hierarchy<L> {
     /// overflow), within two `f64` roundings (`2^-52` relative) of the exact value, which the
     /// pad's factor `1 + 2^-18` on the reach absorbs ([`super::Relative`]).
     fn measure(&self, boxes: &[PrimBox]) -> f64 {
-        let mut reach = 0.0f64;
+        let mut reach = self.layout.stored_reach();
         for b in boxes {
             for k in 0..3 {
                 reach = reach.max(f64::from(b.min[k]).abs().max(f64::from(b.max[k]).abs()));
             }
-        }
-        for i in 0..self.layout.len() {
-            let (c, e) = self.layout.node_box_f64(i as u32);
-            reach = reach.max((c.abs() + e).max_element());
         }
         reach
     }
 
     /// The tree's bytes: the nodes, child references included.
     pub fn node_bytes(&self) -> usize {
-        self.layout.len() * L::NODE_BYTES
-    }
-
-    /// A reference's box as `(center, extent)`, primitives from `prim`.
-    #[inline(always)]
-    pub fn box_of(&self, r: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
-        if r.is_primitive() {
-            prim(r.index())
-        } else {
-            self.layout.node_box(r.index())
-        }
+        self.layout.bytes()
     }
 }
 
@@ -175,11 +161,18 @@ fn check_vertices(vertices: &[Vec3]) -> Result<(), MeshError> {
     }
 }
 
-fn prim_box(p: [Vec3; 3]) -> PrimBox {
-    PrimBox {
-        min: p[0].min(p[1]).min(p[2]).to_array(),
-        max: p[0].max(p[1]).max(p[2]).to_array(),
-    }
+/// Every triangle's box (indices checked).
+fn prim_boxes(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<PrimBox> {
+    triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| vertices[v as usize]);
+            PrimBox {
+                min: p[0].min(p[1]).min(p[2]).to_array(),
+                max: p[0].max(p[1]).max(p[2]).to_array(),
+            }
+        })
+        .collect()
 }
 
 /// A triangle mesh in its own frame, with an AABB tree over its triangles.
@@ -216,23 +209,16 @@ impl<L: Layout> TriMesh<L> {
             }
         }
         check_vertices(&vertices)?;
-        let mut mesh = TriMesh {
+        let tree = Hierarchy::new(&prim_boxes(&vertices, &triangles));
+        Ok(TriMesh {
             vertices,
             triangles,
-            tree: Hierarchy {
-                layout: L::from_boxes(&[], &[], &[]),
-                root: Ref::primitive(0),
-                reach: 0.0,
-            },
-        };
-        mesh.tree = Hierarchy::new(&mesh.prim_boxes());
-        Ok(mesh)
+            tree,
+        })
     }
 
     fn prim_boxes(&self) -> Vec<PrimBox> {
-        (0..self.triangles.len())
-            .map(|i| prim_box(self.corners(i as u32)))
-            .collect()
+        prim_boxes(&self.vertices, &self.triangles)
     }
 
     /// The same mesh and tree topology, with nodes in another layout.

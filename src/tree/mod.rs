@@ -44,7 +44,7 @@ mod relative;
 mod triangle;
 
 pub use mesh::{AabbTree, MeshError, TriMesh};
-pub use nodes::{Compact, Layout, Quantized};
+pub use nodes::{Compact, Layout, Paired, Quantized};
 pub use query::{Query, Shape, Stats};
 pub use relative::{Object, QueryError, Relative};
 pub use triangle::{triangles_distance_sq, triangles_intersect};

@@ -13,6 +13,7 @@
 //! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
 //! coordinate (`origin + step·c`); the query pad covers that rounding.
 
+use super::build::PrimBox;
 use crate::num::{ceil, pow2, pow2_at_least, round, round_up, two_sum};
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3A};
@@ -96,20 +97,63 @@ pub trait Layout: Store + Clone + core::fmt::Debug {}
 
 /// The crate-private access every layout gives the builder and the queries.
 pub(crate) trait Store {
-    /// The layout over `children`, whose node `i` has the exact box `[min[i], max[i]]`.
-    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self;
-    /// Node `i` as `(center, extent)`, as the queries read it.
-    fn node_box(&self, i: u32) -> (Vec3A, Vec3A);
-    /// Node `i` as stored, `(center, extent)` in `f64`: finite for every finite tree (the
-    /// `f32` read-back of a quantized node may overflow where this does not), within two
-    /// `f64` roundings of the exact values.
-    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3);
+    /// The layout over `children`, whose node `i` has the exact box `[min[i], max[i]]` and
+    /// primitive `p` the exact box `prim(p)`.
+    fn from_boxes(
+        children: &[[Ref; 2]],
+        min: &[[f32; 3]],
+        max: &[[f32; 3]],
+        prim: impl Fn(u32) -> PrimBox,
+    ) -> Self;
+    /// The two children of node `i` with their boxes `(center, extent)` as the queries read
+    /// them; a primitive's box from `prim` where the layout does not store it.
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2];
+    /// The box of the tree's root `root`, as the queries read it (`prim` as above).
+    fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A);
+    /// The largest `|coordinate|` of any box the layout stores, in `f64`: finite for every
+    /// finite tree (the `f32` read-back of a quantized box may overflow where this does
+    /// not), within two `f64` roundings of the exact value.
+    fn stored_reach(&self) -> f64;
     /// The children of node `i`.
     fn children(&self, i: u32) -> [Ref; 2];
     /// The number of nodes.
     fn len(&self) -> usize;
-    /// The bytes of one node.
-    const NODE_BYTES: usize;
+    /// The bytes the layout stores: its nodes, and what it keeps beside them.
+    fn bytes(&self) -> usize;
+}
+
+/// A child as the descent reads it: its reference and its box `center ± extent`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Child {
+    pub r: Ref,
+    pub center: Vec3A,
+    pub extent: Vec3A,
+}
+
+/// The children of a node in a layout where every node stores its own box (`node`), and
+/// primitives' boxes come from `prim`.
+#[inline(always)]
+fn own_boxes(
+    children: [Ref; 2],
+    node: impl Fn(u32) -> (Vec3A, Vec3A),
+    prim: impl Fn(u32) -> (Vec3A, Vec3A),
+) -> [Child; 2] {
+    let child = |r: Ref| {
+        let (center, extent) = if r.is_primitive() {
+            prim(r.index())
+        } else {
+            node(r.index())
+        };
+        Child { r, center, extent }
+    };
+    [child(children[0]), child(children[1])]
+}
+
+/// The largest `|c| + e` of `boxes`, in `f64`.
+fn reach_of(boxes: impl Iterator<Item = (DVec3, DVec3)>) -> f64 {
+    boxes.fold(0.0f64, |reach, (c, e)| {
+        reach.max((c.abs() + e).max_element())
+    })
 }
 
 /// Nodes of 32 bytes: an `f32` center and extent, two child references.
@@ -120,8 +164,21 @@ pub struct Compact {
 
 impl Layout for Compact {}
 
+impl Compact {
+    #[inline(always)]
+    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
+        let n = &self.nodes[i as usize];
+        (Vec3A::from_array(n.center), Vec3A::from_array(n.extent))
+    }
+}
+
 impl Store for Compact {
-    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self {
+    fn from_boxes(
+        children: &[[Ref; 2]],
+        min: &[[f32; 3]],
+        max: &[[f32; 3]],
+        _prim: impl Fn(u32) -> PrimBox,
+    ) -> Self {
         let nodes = children
             .iter()
             .zip(min.iter().zip(max))
@@ -137,13 +194,22 @@ impl Store for Compact {
         Compact { nodes }
     }
     #[inline(always)]
-    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
-        let n = &self.nodes[i as usize];
-        (Vec3A::from_array(n.center), Vec3A::from_array(n.extent))
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+        own_boxes(self.children(i), |j| self.node_box(j), prim)
     }
-    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3) {
-        let (c, e) = self.node_box(i);
-        (c.as_dvec3(), e.as_dvec3())
+    #[inline(always)]
+    fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
+        if root.is_primitive() {
+            prim(root.index())
+        } else {
+            self.node_box(root.index())
+        }
+    }
+    fn stored_reach(&self) -> f64 {
+        reach_of((0..self.nodes.len() as u32).map(|i| {
+            let (c, e) = self.node_box(i);
+            (c.as_dvec3(), e.as_dvec3())
+        }))
     }
     #[inline(always)]
     fn children(&self, i: u32) -> [Ref; 2] {
@@ -152,7 +218,9 @@ impl Store for Compact {
     fn len(&self) -> usize {
         self.nodes.len()
     }
-    const NODE_BYTES: usize = core::mem::size_of::<Node>();
+    fn bytes(&self) -> usize {
+        self.nodes.len() * core::mem::size_of::<Node>()
+    }
 }
 
 /// Nodes of 20 bytes: 16-bit integer centers and extents on a per-tree grid (a power-of-two
@@ -214,12 +282,43 @@ impl Quantized {
     }
 }
 
-impl Store for Quantized {
-    fn from_boxes(children: &[[Ref; 2]], min: &[[f32; 3]], max: &[[f32; 3]]) -> Self {
-        let (origin, step) = match (min.first(), max.first()) {
+impl Quantized {
+    /// The grid of `from_boxes`: the root's box is node 0's.
+    fn grid_of(min: &[[f32; 3]], max: &[[f32; 3]]) -> (Vec3A, Vec3A) {
+        match (min.first(), max.first()) {
             (Some(&lo), Some(&hi)) => Self::grid(lo, hi),
             _ => (Vec3A::ZERO, Vec3A::ONE),
-        };
+        }
+    }
+}
+
+/// A grid box read back: `step·c` and `step·e` are exact (a power of two times a 16-bit
+/// integer); the sum rounds once (relative u), which the query pad's box-rounding term
+/// covers.
+#[inline(always)]
+fn grid_box(origin: Vec3A, step: Vec3A, c: [i16; 3], e: [u16; 3]) -> (Vec3A, Vec3A) {
+    let c = Vec3A::new(f32::from(c[0]), f32::from(c[1]), f32::from(c[2]));
+    let e = Vec3A::new(f32::from(e[0]), f32::from(e[1]), f32::from(e[2]));
+    (origin + step * c, step * e)
+}
+
+/// A grid box in `f64`: `step·c` and `step·e` exact (at most 2^113 · 2^16), the sum
+/// rounded once.
+fn grid_box_f64(origin: Vec3A, step: Vec3A, c: [i16; 3], e: [u16; 3]) -> (DVec3, DVec3) {
+    let c = DVec3::from_array(c.map(f64::from));
+    let e = DVec3::from_array(e.map(f64::from));
+    let step = step.as_dvec3();
+    (origin.as_dvec3() + step * c, step * e)
+}
+
+impl Store for Quantized {
+    fn from_boxes(
+        children: &[[Ref; 2]],
+        min: &[[f32; 3]],
+        max: &[[f32; 3]],
+        _prim: impl Fn(u32) -> PrimBox,
+    ) -> Self {
+        let (origin, step) = Self::grid_of(min, max);
         let nodes = children
             .iter()
             .zip(min.iter().zip(max))
@@ -239,29 +338,31 @@ impl Store for Quantized {
         }
     }
     #[inline(always)]
-    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
-        let n = &self.nodes[i as usize];
-        let c = Vec3A::new(
-            f32::from(n.center[0]),
-            f32::from(n.center[1]),
-            f32::from(n.center[2]),
-        );
-        let e = Vec3A::new(
-            f32::from(n.extent[0]),
-            f32::from(n.extent[1]),
-            f32::from(n.extent[2]),
-        );
-        // step·c and step·e are exact (a power of two times a 16-bit integer); the sum
-        // rounds once (relative u), which the query pad's box-rounding term covers.
-        (self.origin + self.step * c, self.step * e)
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+        own_boxes(
+            self.children(i),
+            |j| {
+                let n = &self.nodes[j as usize];
+                grid_box(self.origin, self.step, n.center, n.extent)
+            },
+            prim,
+        )
     }
-    fn node_box_f64(&self, i: u32) -> (DVec3, DVec3) {
-        let n = &self.nodes[i as usize];
-        let c = DVec3::from_array(n.center.map(f64::from));
-        let e = DVec3::from_array(n.extent.map(f64::from));
-        // step·c and step·e exact (at most 2^113 · 2^16), the sum rounded once.
-        let step = self.step.as_dvec3();
-        (self.origin.as_dvec3() + step * c, step * e)
+    #[inline(always)]
+    fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
+        if root.is_primitive() {
+            prim(root.index())
+        } else {
+            let n = &self.nodes[root.index() as usize];
+            grid_box(self.origin, self.step, n.center, n.extent)
+        }
+    }
+    fn stored_reach(&self) -> f64 {
+        reach_of(
+            self.nodes
+                .iter()
+                .map(|n| grid_box_f64(self.origin, self.step, n.center, n.extent)),
+        )
     }
     #[inline(always)]
     fn children(&self, i: u32) -> [Ref; 2] {
@@ -270,5 +371,124 @@ impl Store for Quantized {
     fn len(&self) -> usize {
         self.nodes.len()
     }
-    const NODE_BYTES: usize = core::mem::size_of::<QNode>();
+    fn bytes(&self) -> usize {
+        self.nodes.len() * core::mem::size_of::<QNode>()
+    }
+}
+
+/// A paired node: both children's boxes on the tree's grid, and the two children (32
+/// bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PNode {
+    pub center: [[i16; 3]; 2],
+    pub extent: [[u16; 3]; 2],
+    pub children: [Ref; 2],
+}
+
+/// Nodes of 32 bytes that hold their two children's boxes, primitives' included, on a
+/// per-tree grid as [`Quantized`] does; the root's box is kept apart as a [`Compact`] node's.
+///
+/// A descent step reads one node for both children's boxes, and never derives a
+/// primitive's box from its vertices; a tree over `n` primitives costs `32·(n − 1)` bytes
+/// plus the root's box.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Paired {
+    nodes: Vec<PNode>,
+    /// The root's `center ± extent`, rounded outward ([`outward`]).
+    root: ([f32; 3], [f32; 3]),
+    origin: Vec3A,
+    step: Vec3A,
+}
+
+impl Layout for Paired {}
+
+impl Store for Paired {
+    fn from_boxes(
+        children: &[[Ref; 2]],
+        min: &[[f32; 3]],
+        max: &[[f32; 3]],
+        prim: impl Fn(u32) -> PrimBox,
+    ) -> Self {
+        let (origin, step) = Quantized::grid_of(min, max);
+        let boxed = |r: Ref| {
+            let b = if r.is_primitive() {
+                prim(r.index())
+            } else {
+                PrimBox {
+                    min: min[r.index() as usize],
+                    max: max[r.index() as usize],
+                }
+            };
+            Quantized::quantize(origin, step, b.min, b.max)
+        };
+        let nodes = children
+            .iter()
+            .map(|&children| {
+                let [(c0, e0), (c1, e1)] = children.map(boxed);
+                PNode {
+                    center: [c0, c1],
+                    extent: [e0, e1],
+                    children,
+                }
+            })
+            .collect();
+        let root = match (min.first(), max.first()) {
+            (Some(&lo), Some(&hi)) => outward(lo, hi),
+            _ => {
+                let b = prim(0);
+                outward(b.min, b.max)
+            }
+        };
+        Paired {
+            nodes,
+            root,
+            origin,
+            step,
+        }
+    }
+    #[inline(always)]
+    fn children_boxes(&self, i: u32, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+        let n = &self.nodes[i as usize];
+        let child = |k: usize| {
+            let (center, extent) = grid_box(self.origin, self.step, n.center[k], n.extent[k]);
+            Child {
+                r: n.children[k],
+                center,
+                extent,
+            }
+        };
+        [child(0), child(1)]
+    }
+    #[inline(always)]
+    fn root_box(&self, _root: Ref, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
+        (
+            Vec3A::from_array(self.root.0),
+            Vec3A::from_array(self.root.1),
+        )
+    }
+    fn stored_reach(&self) -> f64 {
+        let (c, e) = self.root;
+        let root = (
+            Vec3A::from_array(c).as_dvec3(),
+            Vec3A::from_array(e).as_dvec3(),
+        );
+        reach_of(
+            self.nodes
+                .iter()
+                .flat_map(|n| {
+                    [0, 1].map(|k| grid_box_f64(self.origin, self.step, n.center[k], n.extent[k]))
+                })
+                .chain([root]),
+        )
+    }
+    #[inline(always)]
+    fn children(&self, i: u32) -> [Ref; 2] {
+        self.nodes[i as usize].children
+    }
+    fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    fn bytes(&self) -> usize {
+        self.nodes.len() * core::mem::size_of::<PNode>() + core::mem::size_of_val(&self.root)
+    }
 }

@@ -73,7 +73,7 @@
 
 use crate::kernel;
 use crate::num::{pow2, round_up, sqrt};
-use glam::{DMat3, DVec3, Quat, Vec3A};
+use glam::{DMat3, DVec3, Quat, Vec3A, Vec4};
 
 use crate::transform::{Rigid3, Similarity3};
 
@@ -315,6 +315,39 @@ impl Relative {
         d.cmpgt(r).any()
     }
 
+    /// [`Relative::on_a`] on four boxes of `B` in lanes: per lane, the same bits.
+    #[inline(always)]
+    pub(crate) fn on_a_lanes(&self, b: &Lanes) -> Lanes {
+        Lanes {
+            center: plus(lanes_times(&self.cols, &b.center), self.t32),
+            extent: lanes_times(&self.abs_cols, &b.extent),
+        }
+    }
+
+    /// [`Relative::on_b`] on four boxes of `A` in lanes: per lane, the same bits.
+    #[inline(always)]
+    pub(crate) fn on_b_lanes(&self, a: &Lanes) -> Lanes {
+        Lanes {
+            center: plus(lanes_times(&self.rows, &a.center), self.t_b),
+            extent: lanes_times(&self.abs_rows, &a.extent),
+        }
+    }
+
+    /// [`Relative::apart`] per lane, as a lane mask: four boxes `boxes` against one box
+    /// placed on their axes (`placed`), or, with the roles the other way, four placed boxes
+    /// against one box `c ± e`. The same bits as `apart`, lane by lane.
+    #[inline(always)]
+    pub(crate) fn apart_lanes(&self, placed: &Lanes, boxes: &Lanes) -> u32 {
+        let pad = Vec4::splat(self.pad);
+        let mut apart = glam::BVec4A::FALSE;
+        for k in 0..3 {
+            let d = (placed.center[k] - boxes.center[k]).abs();
+            let r = placed.extent[k] + boxes.extent[k] + pad;
+            apart |= d.cmpgt(r);
+        }
+        apart.bitmask()
+    }
+
     /// The same test on `min`/`max` boxes (`a` in `A`'s frame, `b` in `B`'s), read back as
     /// center and extent with the rounding the pad covers; for the reaches given to
     /// [`Relative::new`]. An empty box never overlaps; NaN faces always do (conservative).
@@ -429,10 +462,117 @@ pub(crate) struct Placed {
     reach: Vec3A,
 }
 
+/// Four boxes in lanes: `center[k]` and `extent[k]` hold coordinate `k` of each.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lanes {
+    pub center: [Vec4; 3],
+    pub extent: [Vec4; 3],
+}
+
+impl Lanes {
+    /// One box in all four lanes.
+    #[inline(always)]
+    pub(crate) fn splat(center: Vec3A, extent: Vec3A) -> Self {
+        Lanes {
+            center: splat3(center),
+            extent: splat3(extent),
+        }
+    }
+
+    /// Four boxes, `center ± extent`, one per lane.
+    #[inline(always)]
+    pub(crate) fn new(center: [Vec3A; 4], extent: [Vec3A; 4]) -> Self {
+        Lanes {
+            center: transpose(center),
+            extent: transpose(extent),
+        }
+    }
+}
+
+/// The coordinates of `v`, each in all four lanes.
+#[inline(always)]
+fn splat3(v: Vec3A) -> [Vec4; 3] {
+    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
+}
+
+/// Four vectors as three lanes of coordinates (named fields, not indices: an indexed
+/// `Vec3A` goes through memory, and the loads then wait on the stores).
+#[inline(always)]
+fn transpose([a, b, c, d]: [Vec3A; 4]) -> [Vec4; 3] {
+    [
+        Vec4::new(a.x, b.x, c.x, d.x),
+        Vec4::new(a.y, b.y, c.y, d.y),
+        Vec4::new(a.z, b.z, c.z, d.z),
+    ]
+}
+
+/// `Σ_j m[j]·v[j]` per coordinate, in lanes: coordinate `k` is
+/// `(m[0]_k·v_0 + m[1]_k·v_1) + m[2]_k·v_2`, the order of the `Vec3A` sums of
+/// [`Relative::on_a`] and [`Relative::on_b`] (so the same bits).
+#[inline(always)]
+fn lanes_times(m: &[Vec3A; 3], v: &[Vec4; 3]) -> [Vec4; 3] {
+    let [m0, m1, m2] = m.map(splat3);
+    [
+        m0[0] * v[0] + m1[0] * v[1] + m2[0] * v[2],
+        m0[1] * v[0] + m1[1] * v[1] + m2[1] * v[2],
+        m0[2] * v[0] + m1[2] * v[1] + m2[2] * v[2],
+    ]
+}
+
+/// `v + t` per coordinate, in lanes.
+#[inline(always)]
+fn plus(v: [Vec4; 3], t: Vec3A) -> [Vec4; 3] {
+    let t = splat3(t);
+    [v[0] + t[0], v[1] + t[1], v[2] + t[2]]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Quat;
+
+    /// Four boxes in lanes give, lane by lane, the same placed bits and answers as one at
+    /// a time, either side in lanes.
+    #[test]
+    fn boxes_in_lanes_give_the_same_bits() {
+        let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || next() as f32;
+        let (mut apart, mut near) = (0, 0);
+        for _ in 0..100 {
+            let mut pose = || Rigid3 {
+                rotation: Quat::from_xyzw(next(), next(), next(), next()).normalize(),
+                translation: Vec3A::new(next(), next(), next()) * 0.5,
+            };
+            let (pa, pb) = (pose(), pose());
+            let rel = Relative::new(&pa, 4.0, &pb, 4.0, 0.0).expect("a finite pose");
+            let mut corner = || Vec3A::new(next(), next(), next());
+            let boxes: [(Vec3A, Vec3A); 5] = core::array::from_fn(|_| (corner(), corner().abs()));
+            let [(c, e), rest @ ..] = boxes;
+            let lanes = Lanes::new(rest.map(|b| b.0), rest.map(|b| b.1));
+            let one = Lanes::splat(c, e);
+            // `rest` in A's frame, the one box in B's; then the other way round.
+            let a_side = rel.apart_lanes(&rel.on_a_lanes(&one), &lanes)
+                | rel.apart_lanes(&rel.on_b_lanes(&lanes), &one);
+            let b_side = rel.apart_lanes(&rel.on_a_lanes(&lanes), &one)
+                | rel.apart_lanes(&rel.on_b_lanes(&one), &lanes);
+            let placed = rel.on_b_lanes(&lanes);
+            for (l, &(cl, el)) in rest.iter().enumerate() {
+                let p = rel.on_b(cl, el);
+                let lane = |v: &[Vec4; 3]| Vec3A::new(v[0][l], v[1][l], v[2][l]);
+                assert_eq!(lane(&placed.center).to_array(), p.center.to_array());
+                assert_eq!(lane(&placed.extent).to_array(), p.reach.to_array());
+                let overlaps_a = rel.overlaps_ce(cl, el, c, e);
+                assert_eq!(a_side >> l & 1 == 0, overlaps_a);
+                assert_eq!(b_side >> l & 1 == 0, rel.overlaps_ce(c, e, cl, el));
+                if overlaps_a {
+                    near += 1;
+                } else {
+                    apart += 1;
+                }
+            }
+        }
+        assert!(apart > 50 && near > 50, "{apart} apart, {near} near");
+    }
 
     /// A box placed once gives `overlaps_ce`'s answer on every pair, either side placed.
     #[test]
