@@ -13,7 +13,7 @@ use std::ops::ControlFlow;
 use std::time::Duration;
 
 use bvkit::Rigid3;
-use bvkit::tree::{Quantized, TriMesh};
+use bvkit::tree::{Paired, Quantized, TriMesh};
 use bvkit_support::criterion;
 use criterion::{Criterion, criterion_group, criterion_main};
 use parry3d::bounding_volume::BoundingVolume;
@@ -62,6 +62,7 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
     let a = TriMesh::new(ma.0.clone(), ma.1.clone()).unwrap();
     let b = TriMesh::new(mb.0.clone(), mb.1.clone()).unwrap();
     let (aq, bq) = (a.with_layout::<Quantized>(), b.with_layout::<Quantized>());
+    let (aw, bw) = (a.with_layout::<Paired>(), b.with_layout::<Paired>());
     let pa = ParryMesh::new(ma.0, ma.1).unwrap();
     let pb = ParryMesh::new(mb.0, mb.1).unwrap();
     let id = Rigid3::IDENTITY;
@@ -78,11 +79,12 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
     }
     let tris = b.triangles().len() as f64;
     println!(
-        "{name}: node pairs/query first contact {:.0}, all pairs {:.0}; B/tri compact {:.1}, quantized {:.1}, parry {:.1}",
+        "{name}: node pairs/query first contact {:.0}, all pairs {:.0}; B/tri compact {:.1}, quantized {:.1}, paired {:.1}, parry {:.1}",
         first as f64 / n,
         all as f64 / n,
         b.tree_bytes() as f64 / tris,
         bq.tree_bytes() as f64 / tris,
+        bw.tree_bytes() as f64 / tris,
         pb.bvh().total_memory_size() as f64 / tris,
     );
     let mut g = c.benchmark_group(format!("trees/{name}"));
@@ -105,6 +107,14 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
                 .count()
         })
     });
+    g.bench_function("intersects/bvkit-paired", |it| {
+        it.iter(|| {
+            poses
+                .iter()
+                .filter(|&&p| aw.intersects(id, black_box(&bw), p).unwrap())
+                .count()
+        })
+    });
     g.bench_function("intersects/parry3d", |it| {
         it.iter(|| parry_intersects(&pa, black_box(&pb), &poses))
     });
@@ -122,6 +132,18 @@ fn scene(c: &mut Criterion, name: &str, ma: Mesh, mb: Mesh, poses: Vec<Rigid3>) 
                 .iter()
                 .map(|&p| {
                     aq.overlapping_triangles(id, black_box(&bq), p)
+                        .unwrap()
+                        .len()
+                })
+                .sum::<usize>()
+        })
+    });
+    g.bench_function("pairs/bvkit-paired", |it| {
+        it.iter(|| {
+            poses
+                .iter()
+                .map(|&p| {
+                    aw.overlapping_triangles(id, black_box(&bw), p)
                         .unwrap()
                         .len()
                 })

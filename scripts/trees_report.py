@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Tabulates one `cargo bench --features peers --bench trees` run (criterion's JSON under target/criterion):
 per scene and query, µs per query (criterion's median over an iteration of 200 poses) for
-bvkit's compact and quantized trees and for parry3d, and parry3d's time over bvkit's.
+bvkit's compact, quantized and paired trees and for parry3d, and parry3d's time over
+bvkit's fastest layout (named).
 Usage: python3 scripts/trees_report.py [target/criterion]
 """
 import json
@@ -24,12 +25,16 @@ QUERIES = {
     "intersects": "`intersects` vs `query::intersection_test`",
     "pairs": "`overlapping_triangles` vs `Bvh::leaf_pairs` + triangle tests",
 }
-print("| scene | query | bvkit compact | bvkit quantized | parry3d | parry3d / bvkit |")
-print("|---|---|---:|---:|---:|---:|")
+LAYOUTS = {"bvkit": "compact", "bvkit-quantized": "quantized", "bvkit-paired": "paired"}
+print("| scene | query | bvkit compact | bvkit quantized | bvkit paired | parry3d | parry3d / fastest bvkit |")
+print("|---|---|---:|---:|---:|---:|---:|")
 for scene in sorted({k[0] for k in rows}):
     for query, label in QUERIES.items():
-        c, q, p = (rows.get((scene, query, w)) for w in ("bvkit", "bvkit-quantized", "parry3d"))
-        if c is None or p is None:
+        ours = {name: rows.get((scene, query, who)) for who, name in LAYOUTS.items()}
+        p = rows.get((scene, query, "parry3d"))
+        timed = {name: t for name, t in ours.items() if t is not None}
+        if not timed or p is None:
             continue
-        quantized = f"{q:,.1f} µs" if q is not None else "-"
-        print(f"| {scene} | {label} | {c:,.1f} µs | {quantized} | {p:,.1f} µs | {p / c:.1f}× |")
+        best = min(timed, key=timed.get)
+        cells = " | ".join(f"{t:,.1f} µs" if t is not None else "-" for t in ours.values())
+        print(f"| {scene} | {label} | {cells} | {p:,.1f} µs | {p / timed[best]:.1f}× ({best}) |")
