@@ -203,6 +203,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         // Each pair on the stack passed its box test; the stack's top is the next pair in
         // descent order, leaves included, so pairs of primitives leave in that order.
         let mut stack = Pending::default();
+        stack.reserve(1);
         stack.put(ha.root, ca, ea, hb.root, cb, eb, true);
         let mut leaves = [(0u32, 0u32); LANES];
         let mut found = 0;
@@ -338,11 +339,10 @@ impl Pending {
     }
 
     /// Writes the pair `(ra, rb)` (boxes `ca ± ea`, `cb ± eb`) at the top, and keeps it
-    /// when `keep`.
+    /// when `keep`. The caller reserves the room first ([`Pending::reserve`]).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn put(&mut self, ra: Ref, ca: Vec3A, ea: Vec3A, rb: Ref, cb: Vec3A, eb: Vec3A, keep: bool) {
-        self.reserve(1);
         let split_a =
             !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum());
         let kind = if ra.is_primitive() && rb.is_primitive() {
