@@ -4,7 +4,7 @@
 use alloc::vec::Vec;
 use core::ops::ControlFlow;
 
-use glam::{DVec3, Vec3A};
+use glam::{BVec3A, DVec3, Vec3A, Vec4};
 
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Child, Layout, Ref, Store};
@@ -204,7 +204,10 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         // descent order, leaves included, so pairs of primitives leave in that order.
         let mut stack = Pending::default();
         stack.reserve(1);
-        stack.put(ha.root, ca, ea, hb.root, cb, eb, true);
+        let split_a = !ha.root.is_primitive()
+            && (hb.root.is_primitive() || ea.element_sum() >= eb.element_sum());
+        let carried = if split_a { (cb, eb) } else { (ca, ea) };
+        stack.put((ha.root, hb.root, Kind::of(false, split_a)), carried, true);
         let mut leaves = [(0u32, 0u32); LANES];
         let mut found = 0;
         let flush_at = flush_at.clamp(1, LANES);
@@ -230,31 +233,56 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             // tests at once, each kept by a count, not a branch.
             stack.reserve(4);
             let fixed = Lanes::splat(cf, ef);
+            // What each new pair does next, decided in lanes: split the side with the larger
+            // extent (summed), never a primitive; two primitives are a leaf.
+            let fixed_sum = Vec4::splat(ef.x + ef.y + ef.z);
             if kind == Kind::SplitA {
                 let below = Below::new(la, ra.index(), prim_a);
                 stats.node_pairs += u64::from(below.valid.count_ones());
                 let apart = rel.apart_lanes(&rel.on_a_lanes(&fixed), &below.lanes)
                     | rel.apart_lanes(&rel.on_b_lanes(&below.lanes), &fixed);
+                let kid_prim = below.primitives();
+                let fixed_prim = if rb.is_primitive() { 0b1111 } else { 0 };
+                let larger = below.extent_sums().cmpge(fixed_sum).bitmask();
+                let split_a = !kid_prim & (fixed_prim | larger);
                 for (l, kid) in below.kids.iter().enumerate().rev() {
                     let (ca, ea) = (kid.center, kid.extent);
                     let mut keep = (below.valid & !apart) >> l & 1 != 0;
-                    if self.cross_near_leaves && keep && kid.r.is_primitive() && rb.is_primitive() {
+                    let leaf = (kid_prim & fixed_prim) >> l & 1 != 0;
+                    if self.cross_near_leaves && keep && leaf {
                         keep = !rel.roots_separated(ca, ea, cf, ef, margin);
                     }
-                    stack.put(kid.r, ca, ea, rb, cf, ef, keep);
+                    // Splitting `A` next carries `B`'s box, the fixed one.
+                    let split = split_a >> l & 1 != 0;
+                    let carried = (
+                        Vec3A::select(BVec3A::splat(split), cf, ca),
+                        Vec3A::select(BVec3A::splat(split), ef, ea),
+                    );
+                    stack.put((kid.r, rb, Kind::of(leaf, split)), carried, keep);
                 }
             } else {
                 let below = Below::new(lb, rb.index(), prim_b);
                 stats.node_pairs += u64::from(below.valid.count_ones());
                 let apart = rel.apart_lanes(&rel.on_a_lanes(&below.lanes), &fixed)
                     | rel.apart_lanes(&rel.on_b_lanes(&fixed), &below.lanes);
+                let kid_prim = below.primitives();
+                let fixed_prim = if ra.is_primitive() { 0b1111 } else { 0 };
+                let larger = below.extent_sums().cmpgt(fixed_sum).bitmask();
+                let split_a = !fixed_prim & (kid_prim | !larger);
                 for (l, kid) in below.kids.iter().enumerate().rev() {
                     let (cb, eb) = (kid.center, kid.extent);
                     let mut keep = (below.valid & !apart) >> l & 1 != 0;
-                    if self.cross_near_leaves && keep && ra.is_primitive() && kid.r.is_primitive() {
+                    let leaf = (kid_prim & fixed_prim) >> l & 1 != 0;
+                    if self.cross_near_leaves && keep && leaf {
                         keep = !rel.roots_separated(cf, ef, cb, eb, margin);
                     }
-                    stack.put(ra, cf, ef, kid.r, cb, eb, keep);
+                    // Splitting `A` next carries `B`'s box, the kid's.
+                    let split = split_a >> l & 1 != 0;
+                    let carried = (
+                        Vec3A::select(BVec3A::splat(split), cb, cf),
+                        Vec3A::select(BVec3A::splat(split), eb, ef),
+                    );
+                    stack.put((ra, kid.r, Kind::of(leaf, split)), carried, keep);
                 }
             }
         }
@@ -273,6 +301,19 @@ struct Below {
 }
 
 impl Below {
+    /// The lanes that hold a primitive.
+    #[inline(always)]
+    fn primitives(&self) -> u32 {
+        let p = |l: usize| self.kids[l].r.0 >> 31;
+        p(0) | p(1) << 1 | p(2) << 2 | p(3) << 3
+    }
+
+    /// Each lane's extent summed over the three axes (the split heuristic's measure).
+    #[inline(always)]
+    fn extent_sums(&self) -> Vec4 {
+        self.lanes.extent[0] + self.lanes.extent[1] + self.lanes.extent[2]
+    }
+
     #[inline(always)]
     fn new<L: Store>(layout: &L, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A) + Copy) -> Self {
         let none = Child {
@@ -312,6 +353,19 @@ enum Kind {
     Leaf,
 }
 
+impl Kind {
+    #[inline(always)]
+    fn of(leaf: bool, split_a: bool) -> Self {
+        if leaf {
+            Kind::Leaf
+        } else if split_a {
+            Kind::SplitA
+        } else {
+            Kind::SplitB
+        }
+    }
+}
+
 /// The pairs of the descent whose boxes overlap: each says what to do next, decided when
 /// both boxes were at hand (split the node with the larger extent), and carries the other
 /// side's box (`center ± extent`), which the split's two children are tested against.
@@ -338,22 +392,13 @@ impl Pending {
         }
     }
 
-    /// Writes the pair `(ra, rb)` (boxes `ca ± ea`, `cb ± eb`) at the top, and keeps it
-    /// when `keep`. The caller reserves the room first ([`Pending::reserve`]).
-    #[allow(clippy::too_many_arguments)]
+    /// Writes a pair (its references and what it does next) and the box it carries at the
+    /// top, and keeps it when `keep`. The caller reserves the room first
+    /// ([`Pending::reserve`]).
     #[inline(always)]
-    fn put(&mut self, ra: Ref, ca: Vec3A, ea: Vec3A, rb: Ref, cb: Vec3A, eb: Vec3A, keep: bool) {
-        let split_a =
-            !ra.is_primitive() && (rb.is_primitive() || ea.element_sum() >= eb.element_sum());
-        let kind = if ra.is_primitive() && rb.is_primitive() {
-            Kind::Leaf
-        } else if split_a {
-            Kind::SplitA
-        } else {
-            Kind::SplitB
-        };
-        self.pairs[self.top] = (ra, rb, kind);
-        self.boxes[self.top] = if split_a { (cb, eb) } else { (ca, ea) };
+    fn put(&mut self, pair: (Ref, Ref, Kind), carried: (Vec3A, Vec3A), keep: bool) {
+        self.pairs[self.top] = pair;
+        self.boxes[self.top] = carried;
         self.top += usize::from(keep);
     }
 
