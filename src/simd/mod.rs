@@ -280,6 +280,44 @@ pub(crate) fn prefetch<T>(x: &T) {
     let _ = x;
 }
 
+/// Four vectors as three lanes of coordinates: `[x, y, z]`, lane `l` of each from `v[l]`.
+/// On x86-64 a 4×4 transpose in registers (unpacks and moves); built lane by lane, the
+/// vectors would go through memory and their loads wait on the stores.
+#[inline(always)]
+pub(crate) fn transpose3(v: [glam::Vec3A; 4]) -> [glam::Vec4; 3] {
+    let [a, b, c, d] = v;
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{
+            __m128, _mm_movehl_ps, _mm_movelh_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        };
+        let (a, b, c, d) = (
+            __m128::from(a),
+            __m128::from(b),
+            __m128::from(c),
+            __m128::from(d),
+        );
+        #[allow(unsafe_code)]
+        // SAFETY: the unpacks and moves need only SSE, part of the x86-64 baseline; they
+        // read and write registers, nothing else.
+        unsafe {
+            let (ab_lo, cd_lo) = (_mm_unpacklo_ps(a, b), _mm_unpacklo_ps(c, d));
+            let (ab_hi, cd_hi) = (_mm_unpackhi_ps(a, b), _mm_unpackhi_ps(c, d));
+            [
+                _mm_movelh_ps(ab_lo, cd_lo).into(),
+                _mm_movehl_ps(cd_lo, ab_lo).into(),
+                _mm_movelh_ps(ab_hi, cd_hi).into(),
+            ]
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    [
+        glam::Vec4::new(a.x, b.x, c.x, d.x),
+        glam::Vec4::new(a.y, b.y, c.y, d.y),
+        glam::Vec4::new(a.z, b.z, c.z, d.z),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

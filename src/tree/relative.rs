@@ -483,8 +483,8 @@ impl Lanes {
     #[inline(always)]
     pub(crate) fn new(center: [Vec3A; 4], extent: [Vec3A; 4]) -> Self {
         Lanes {
-            center: transpose(center),
-            extent: transpose(extent),
+            center: crate::simd::transpose3(center),
+            extent: crate::simd::transpose3(extent),
         }
     }
 }
@@ -493,17 +493,6 @@ impl Lanes {
 #[inline(always)]
 fn splat3(v: Vec3A) -> [Vec4; 3] {
     [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
-}
-
-/// Four vectors as three lanes of coordinates (named fields, not indices: an indexed
-/// `Vec3A` goes through memory, and the loads then wait on the stores).
-#[inline(always)]
-fn transpose([a, b, c, d]: [Vec3A; 4]) -> [Vec4; 3] {
-    [
-        Vec4::new(a.x, b.x, c.x, d.x),
-        Vec4::new(a.y, b.y, c.y, d.y),
-        Vec4::new(a.z, b.z, c.z, d.z),
-    ]
 }
 
 /// `Σ_j m[j]·v[j]` per coordinate, in lanes: coordinate `k` is
