@@ -318,6 +318,56 @@ pub(crate) fn transpose3(v: [glam::Vec3A; 4]) -> [glam::Vec4; 3] {
     ]
 }
 
+/// Two boxes on a 16-bit grid, `q = [c₀, e₀, c₁, e₁]` (three values each; centers signed,
+/// stored as their bits, extents unsigned), as `[(c₀, e₀), (c₁, e₁)]` in grid steps,
+/// converted exactly to `f32` (the `w` lanes unspecified). On x86-64 four 8-byte loads and
+/// SSE2 unpacks; value by value, the vectors would go through memory.
+#[inline(always)]
+pub(crate) fn grid_pair(q: &[u16; 12]) -> [(glam::Vec3A, glam::Vec3A); 2] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{
+            __m128i, _mm_cvtepi32_ps, _mm_loadl_epi64, _mm_setzero_si128, _mm_srai_epi32,
+            _mm_srli_si128, _mm_unpacklo_epi16,
+        };
+        #[allow(unsafe_code)]
+        // SAFETY: the four loads read `q[0..4]`, `q[3..7]`, `q[6..10]` and `q[8..12]`, all
+        // within the live reference (unaligned loads); the rest needs only SSE2, part of
+        // the x86-64 baseline.
+        unsafe {
+            let p = q.as_ptr();
+            let at = |k: usize| _mm_loadl_epi64(p.add(k).cast::<__m128i>());
+            // Sign extension: each value in the top half of a 32-bit lane, shifted down
+            // arithmetically; zero extension: interleaved with zeros.
+            let signed = |v: __m128i| {
+                glam::Vec3A::from(_mm_cvtepi32_ps(_mm_srai_epi32::<16>(_mm_unpacklo_epi16(
+                    v, v,
+                ))))
+            };
+            let unsigned = |v: __m128i| {
+                glam::Vec3A::from(_mm_cvtepi32_ps(_mm_unpacklo_epi16(v, _mm_setzero_si128())))
+            };
+            [
+                (signed(at(0)), unsigned(at(3))),
+                (signed(at(6)), unsigned(_mm_srli_si128::<2>(at(8)))),
+            ]
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let signed = |k: usize| {
+            glam::Vec3A::new(
+                f32::from(q[k] as i16),
+                f32::from(q[k + 1] as i16),
+                f32::from(q[k + 2] as i16),
+            )
+        };
+        let unsigned =
+            |k: usize| glam::Vec3A::new(f32::from(q[k]), f32::from(q[k + 1]), f32::from(q[k + 2]));
+        [(signed(0), unsigned(3)), (signed(6), unsigned(9))]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

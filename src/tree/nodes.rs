@@ -376,13 +376,20 @@ impl Store for Quantized {
     }
 }
 
-/// A paired node: both children's boxes on the tree's grid, and the two children (32
-/// bytes).
+/// A paired node: both children's boxes on the tree's grid, `[c₀, e₀, c₁, e₁]` (the
+/// centers' `i16` bits, the extents' `u16`), and the two children (32 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PNode {
-    pub center: [[i16; 3]; 2],
-    pub extent: [[u16; 3]; 2],
+    pub grid: [u16; 12],
     pub children: [Ref; 2],
+}
+
+impl PNode {
+    /// Child `k`'s box on the grid, as stored.
+    fn integers(&self, k: usize) -> ([i16; 3], [u16; 3]) {
+        let q = &self.grid[6 * k..6 * k + 6];
+        ([q[0] as i16, q[1] as i16, q[2] as i16], [q[3], q[4], q[5]])
+    }
 }
 
 /// Nodes of 32 bytes that hold their two children's boxes, primitives' included, on a
@@ -424,12 +431,15 @@ impl Store for Paired {
         let nodes = children
             .iter()
             .map(|&children| {
-                let [(c0, e0), (c1, e1)] = children.map(boxed);
-                PNode {
-                    center: [c0, c1],
-                    extent: [e0, e1],
-                    children,
+                let mut grid = [0u16; 12];
+                for (k, &r) in children.iter().enumerate() {
+                    let (c, e) = boxed(r);
+                    for a in 0..3 {
+                        grid[6 * k + a] = c[a] as u16;
+                        grid[6 * k + 3 + a] = e[a];
+                    }
                 }
+                PNode { grid, children }
             })
             .collect();
         let root = match (min.first(), max.first()) {
@@ -449,15 +459,14 @@ impl Store for Paired {
     #[inline(always)]
     fn children_boxes(&self, i: u32, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
         let n = &self.nodes[i as usize];
-        let child = |k: usize| {
-            let (center, extent) = grid_box(self.origin, self.step, n.center[k], n.extent[k]);
-            Child {
-                r: n.children[k],
-                center,
-                extent,
-            }
+        let [(c0, e0), (c1, e1)] = crate::simd::grid_pair(&n.grid);
+        // As `grid_box`: `step·c` and `step·e` exact, the sum rounded once.
+        let child = |r: Ref, c: Vec3A, e: Vec3A| Child {
+            r,
+            center: self.origin + self.step * c,
+            extent: self.step * e,
         };
-        [child(0), child(1)]
+        [child(n.children[0], c0, e0), child(n.children[1], c1, e1)]
     }
     #[inline(always)]
     fn root_box(&self, _root: Ref, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
@@ -476,7 +485,10 @@ impl Store for Paired {
             self.nodes
                 .iter()
                 .flat_map(|n| {
-                    [0, 1].map(|k| grid_box_f64(self.origin, self.step, n.center[k], n.extent[k]))
+                    [0, 1].map(|k| {
+                        let (c, e) = n.integers(k);
+                        grid_box_f64(self.origin, self.step, c, e)
+                    })
                 })
                 .chain([root]),
         )
