@@ -449,25 +449,23 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
         &self,
         mut f: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
-        self.descend(LANES, |pairs| self.meet_each(pairs, &mut f))
+        // The lanes are written over batch after batch: zeroed once per query, not once per
+        // batch (lanes past a short batch hold an earlier batch's triangles, never read).
+        let mut lanes = ([[[0.0; LANES]; 3]; 3], [[[0.0; LANES]; 3]; 3]);
+        self.descend(LANES, |pairs| self.meet_each(pairs, &mut lanes, &mut f))
     }
 
     /// Calls `f` on the pairs of `batch` whose triangles meet, in order, until it breaks.
     fn meet_each(
         &self,
         batch: &[(u32, u32)],
+        lanes: &mut (TriangleLanes, TriangleLanes),
         f: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         if self.tolerance > 0.0 || batch.len() < 4 {
-            for &(i, j) in batch {
-                if self.triangles_meet(i, j) {
-                    f(i, j)?;
-                }
-            }
-            return ControlFlow::Continue(());
+            return self.meet_one_by_one(batch, f);
         }
-        let mut a: TriangleLanes = [[[0.0; LANES]; 3]; 3];
-        let mut b: TriangleLanes = [[[0.0; LANES]; 3]; 3];
+        let (a, b) = lanes;
         for (l, &(i, j)) in batch.iter().enumerate() {
             let ta = self.a.triangle_f64(i);
             let [b0, b1, b2] = self.b.corners(j);
@@ -483,14 +481,28 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
                 }
             }
         }
-        let verdicts = filter(&a, &b);
+        let verdicts = filter(a, b);
         let corners = |t: &TriangleLanes, l: usize| {
             [0, 1, 2].map(|k| DVec3::new(t[k][0][l], t[k][1][l], t[k][2][l]))
         };
         for (l, &(i, j)) in batch.iter().enumerate() {
             let meet = verdicts.meet[l]
-                || !verdicts.apart[l] && triangles_intersect(&corners(&a, l), &corners(&b, l));
+                || !verdicts.apart[l] && triangles_intersect(&corners(a, l), &corners(b, l));
             if meet {
+                f(i, j)?;
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// [`Query::meet_each`] one pair at a time (no lanes).
+    fn meet_one_by_one(
+        &self,
+        batch: &[(u32, u32)],
+        f: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        for &(i, j) in batch {
+            if self.triangles_meet(i, j) {
                 f(i, j)?;
             }
         }
@@ -509,8 +521,9 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
     #[must_use]
     pub fn first_contact(&self) -> (Option<(u32, u32)>, Stats) {
         let mut first = None;
+        // Batches of one: each triangle test runs alone.
         let (_, stats) = self.descend(1, |pairs| {
-            self.meet_each(pairs, &mut |i, j| {
+            self.meet_one_by_one(pairs, &mut |i, j| {
                 first = Some((i, j));
                 ControlFlow::Break(())
             })
