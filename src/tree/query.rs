@@ -467,19 +467,17 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
         }
         let (a, b) = lanes;
         for (l, &(i, j)) in batch.iter().enumerate() {
-            let ta = self.a.triangle_f64(i);
-            let [b0, b1, b2] = self.b.corners(j);
-            let tb = [
-                self.relative.place(b0),
-                self.relative.place(b1),
-                self.relative.place(b2),
-            ];
+            let (ta, tb) = (self.a.corners(i), self.b.corners(j));
             for k in 0..3 {
                 for c in 0..3 {
-                    a[k][c][l] = ta[k][c];
-                    b[k][c][l] = tb[k][c];
+                    a[k][c][l] = f64::from(ta[k][c]);
+                    b[k][c][l] = f64::from(tb[k][c]);
                 }
             }
+        }
+        // `B`'s corners placed in `A`'s frame, all lanes at once.
+        for corner in b.iter_mut() {
+            self.relative.place_lanes(corner);
         }
         let verdicts = filter(a, b);
         let corners = |t: &TriangleLanes, l: usize| {
