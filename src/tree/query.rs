@@ -466,7 +466,7 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
             return self.meet_one_by_one(batch, f);
         }
         let (a, b) = lanes;
-        for (l, &(i, j)) in batch.iter().enumerate() {
+        for (l, &(i, j)) in (0..LANES).zip(batch) {
             let (ta, tb) = (self.a.corners(i), self.b.corners(j));
             for k in 0..3 {
                 for c in 0..3 {
@@ -483,7 +483,7 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
         let corners = |t: &TriangleLanes, l: usize| {
             [0, 1, 2].map(|k| DVec3::new(t[k][0][l], t[k][1][l], t[k][2][l]))
         };
-        for (l, &(i, j)) in batch.iter().enumerate() {
+        for (l, &(i, j)) in (0..LANES).zip(batch) {
             let meet = verdicts.meet[l]
                 || !verdicts.apart[l] && triangles_intersect(&corners(a, l), &corners(b, l));
             if meet {
