@@ -162,11 +162,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     /// once more for every caller's closure (measured: a call site with `intersects` and
     /// `overlapping_triangles` compiled to 31,226 lines of optimised IR with the closure
     /// generic; see `docs/speed.md`).
-    fn descend(
-        &self,
-        flush_at: usize,
-        batch: &mut dyn FnMut(&[(u32, u32)]) -> ControlFlow<()>,
-    ) -> (ControlFlow<()>, Stats) {
+    fn descend(&self, flush_at: usize, batch: &mut OnBatch<'_>) -> (ControlFlow<()>, Stats) {
         // Compiled in the best backend's dispatch wrapper (three-operand vector
         // instructions, fewer spills of the query's 15 vectors); plain arithmetic, unfused.
         let (broke, stats) = crate::simd::plain(
@@ -185,11 +181,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     }
 
     #[inline(always)]
-    fn descend_here(
-        &self,
-        flush_at: usize,
-        batch: &mut dyn FnMut(&[(u32, u32)]) -> ControlFlow<()>,
-    ) -> (ControlFlow<()>, Stats) {
+    fn descend_here(&self, flush_at: usize, batch: &mut OnBatch<'_>) -> (ControlFlow<()>, Stats) {
         let mut stats = Stats::default();
         let rel = &self.relative;
         let (ha, hb) = (self.a.hierarchy(), self.b.hierarchy());
@@ -348,6 +340,10 @@ impl Below {
         }
     }
 }
+
+/// The descent's consumer: called once per batch of pairs of primitives whose boxes
+/// overlap, it may stop the descent.
+type OnBatch<'f> = dyn FnMut(&[(u32, u32)]) -> ControlFlow<()> + 'f;
 
 /// What a pending pair does next.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
