@@ -1,17 +1,21 @@
-//! Node layouts: [`Compact`] (32 bytes per node) and [`Quantized`] (20 bytes per node).
+//! Node layouts: [`Compact`] (32 bytes per node), [`Quantized`] (20 bytes per node) and
+//! [`Paired`] (32 bytes per node).
 //!
-//! Both are "no-leaf" trees (Opcode's layout): a tree over `n` primitives has `n − 1` inner
-//! nodes, each holding its own box and two child references, and a child is either another
-//! node or a primitive. Primitive boxes are not stored: a mesh derives them from its
-//! triangles at query time. So a tree costs `32·(n − 1)` or `20·(n − 1)` bytes, under 32
-//! and 20 bytes per primitive.
+//! All are "no-leaf" trees (Opcode's layout): a tree over `n` primitives has `n − 1` inner
+//! nodes with two child references each, and a child is either another node or a
+//! primitive. A compact or quantized node holds its own box, and primitive boxes are not
+//! stored: a mesh derives them from its triangles at query time. A paired node holds its
+//! two children's boxes instead, primitives' included, and the root's box is kept apart. So
+//! a tree costs `32·(n − 1)`, `20·(n − 1)` or `32·(n − 1) + 24` bytes, under 32, 20 and 32
+//! bytes per primitive.
 //!
 //! **Containment.** Every stored box contains, as an exact statement about real numbers,
-//! the union of its primitives' boxes: a compact node stores `center ± extent` with the
-//! extent rounded up past the exact distance to both faces ([`outward`]); a quantized node
-//! stores integers whose exact box `origin + step·(c ± e)` is checked to contain the
-//! compact one ([`Quantized::quantize`]). Reading a box back rounds at most once per
-//! coordinate (`origin + step·c`); the query pad covers that rounding.
+//! the union of its primitives' boxes: a compact node (and a paired tree's root) stores
+//! `center ± extent` with the extent rounded up past the exact distance to both faces
+//! ([`outward`]); a quantized box (a quantized node's, or a paired node's child's) is
+//! integers whose exact box `origin + step·(c ± e)` is checked to contain the exact one
+//! ([`Quantized::quantize`]). Reading a box back rounds at most once per coordinate
+//! (`origin + step·c`); the query pad covers that rounding.
 
 use super::build::PrimBox;
 use crate::num::{ceil, pow2, pow2_at_least, round, round_up, two_sum};
@@ -130,8 +134,23 @@ pub(crate) struct Child {
     pub extent: Vec3A,
 }
 
-/// The children of a node in a layout where every node stores its own box (`node`), and
+/// The box of `r` in a layout where every node stores its own box (`node`), and
 /// primitives' boxes come from `prim`.
+#[inline(always)]
+fn own_box(
+    r: Ref,
+    node: impl Fn(u32) -> (Vec3A, Vec3A),
+    prim: impl Fn(u32) -> (Vec3A, Vec3A),
+) -> (Vec3A, Vec3A) {
+    if r.is_primitive() {
+        prim(r.index())
+    } else {
+        node(r.index())
+    }
+}
+
+/// The children of a node, and their boxes, in a layout where every node stores its own
+/// box (as [`own_box`]).
 #[inline(always)]
 fn own_boxes(
     children: [Ref; 2],
@@ -139,11 +158,7 @@ fn own_boxes(
     prim: impl Fn(u32) -> (Vec3A, Vec3A),
 ) -> [Child; 2] {
     let child = |r: Ref| {
-        let (center, extent) = if r.is_primitive() {
-            prim(r.index())
-        } else {
-            node(r.index())
-        };
+        let (center, extent) = own_box(r, &node, &prim);
         Child { r, center, extent }
     };
     [child(children[0]), child(children[1])]
@@ -199,11 +214,7 @@ impl Store for Compact {
     }
     #[inline(always)]
     fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
-        if root.is_primitive() {
-            prim(root.index())
-        } else {
-            self.node_box(root.index())
-        }
+        own_box(root, |j| self.node_box(j), prim)
     }
     fn stored_reach(&self) -> f64 {
         reach_of((0..self.nodes.len() as u32).map(|i| {
@@ -283,6 +294,12 @@ impl Quantized {
 }
 
 impl Quantized {
+    #[inline(always)]
+    fn node_box(&self, i: u32) -> (Vec3A, Vec3A) {
+        let n = &self.nodes[i as usize];
+        grid_box(self.origin, self.step, n.center, n.extent)
+    }
+
     /// The grid of `from_boxes`: the root's box is node 0's.
     fn grid_of(min: &[[f32; 3]], max: &[[f32; 3]]) -> (Vec3A, Vec3A) {
         match (min.first(), max.first()) {
@@ -339,23 +356,11 @@ impl Store for Quantized {
     }
     #[inline(always)]
     fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
-        own_boxes(
-            self.children(i),
-            |j| {
-                let n = &self.nodes[j as usize];
-                grid_box(self.origin, self.step, n.center, n.extent)
-            },
-            prim,
-        )
+        own_boxes(self.children(i), |j| self.node_box(j), prim)
     }
     #[inline(always)]
     fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A) {
-        if root.is_primitive() {
-            prim(root.index())
-        } else {
-            let n = &self.nodes[root.index() as usize];
-            grid_box(self.origin, self.step, n.center, n.extent)
-        }
+        own_box(root, |j| self.node_box(j), prim)
     }
     fn stored_reach(&self) -> f64 {
         reach_of(

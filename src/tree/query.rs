@@ -373,10 +373,9 @@ impl Kind {
 /// both boxes were at hand (split the node with the larger extent), and carries the other
 /// side's box (`center ± extent`), which the split's two children are tested against.
 ///
-/// Two arrays, not one of structs: a pop reads back each field at the width its write had,
-/// so the loads are forwarded from the stores (one array of 48-byte entries, copied
-/// through 32-byte registers, ran the descent 2.7 times slower). An entry is written at
-/// the top whether it is kept or not, and kept by moving the top: no branch.
+/// Two arrays (the pairs, the boxes), each read back at the width it was written. An entry
+/// is written at the top whether it is kept or not, and kept by moving the top: no
+/// branch.
 #[derive(Default)]
 struct Pending {
     pairs: Vec<(Ref, Ref, Kind)>,
