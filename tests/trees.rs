@@ -244,7 +244,42 @@ fn box_tree_leaf_pairs_contain_every_exact_overlap() {
         for &(i, j) in &pairs {
             assert!(rel.overlaps(&ba[i as usize], &bb[j as usize]));
         }
+        // The paired tree holds the boxes on its grid, a little larger; it still reports
+        // only pairs whose own boxes pass (found by the `aabb_tree` fuzz target).
+        for &(i, j) in &wpairs {
+            assert!(
+                rel.overlaps(&ba[i as usize], &bb[j as usize]),
+                "paired {i} {j}"
+            );
+        }
     }
+}
+
+#[test]
+fn paired_trees_report_only_pairs_whose_own_boxes_pass() {
+    // A big box makes the grid coarse (a step of 1/32); the small boxes are 0.01 apart,
+    // far more than the pad and far less than a step. Their grid boxes overlap, their own
+    // boxes do not (found by the `aabb_tree` fuzz target).
+    let big = aabb(Vec3::ZERO, Vec3::splat(1000.0));
+    let a = [big, Aabb3::new(Vec3A::ZERO, Vec3A::splat(0.001))];
+    let b = [
+        big,
+        Aabb3::new(Vec3A::new(0.011, 0.0, 0.0), Vec3A::new(0.012, 0.001, 0.001)),
+    ];
+    let id = Rigid3::IDENTITY;
+    let (ca, cb) = (AabbTree::new(&a).unwrap(), AabbTree::new(&b).unwrap());
+    let (wa, wb) = (
+        AabbTree::<Paired>::build(&a).unwrap(),
+        AabbTree::<Paired>::build(&b).unwrap(),
+    );
+    let q = ca.query(id, &cb, id).unwrap();
+    assert!(!q.relative().overlaps(&a[1], &b[1]));
+    let mut compact = q.leaf_pairs();
+    let mut paired = wa.query(id, &wb, id).unwrap().leaf_pairs();
+    compact.sort_unstable();
+    paired.sort_unstable();
+    assert_eq!(compact, [(0, 0), (0, 1), (1, 0)]);
+    assert_eq!(paired, compact);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -124,6 +124,9 @@ pub(crate) trait Store {
     fn len(&self) -> usize;
     /// The bytes the layout stores: its nodes, and what it keeps beside them.
     fn bytes(&self) -> usize;
+    /// True when the layout stores primitives' boxes (on its grid, so a little larger than
+    /// the primitives' own).
+    const STORES_PRIMITIVES: bool = false;
 }
 
 /// A child as the descent reads it: its reference and its box `center ± extent`.
@@ -402,7 +405,9 @@ impl PNode {
 ///
 /// A descent step reads one node for both children's boxes, and never derives a
 /// primitive's box from its vertices; a tree over `n` primitives costs `32·(n − 1)` bytes
-/// plus the root's box.
+/// plus the root's box. A primitive's box on the grid is a little larger than its own, so
+/// [`super::Query::visit_boxes`] tests the pairs it reports again on their own boxes (a
+/// mesh's pairs go to the exact triangle test anyway).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Paired {
     nodes: Vec<PNode>,
@@ -415,6 +420,8 @@ pub struct Paired {
 impl Layout for Paired {}
 
 impl Store for Paired {
+    const STORES_PRIMITIVES: bool = true;
+
     fn from_boxes(
         children: &[[Ref; 2]],
         min: &[[f32; 3]],

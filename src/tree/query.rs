@@ -132,7 +132,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         &self.relative
     }
 
-    /// Calls `leaf(i, j)` for every pair of primitives whose boxes overlap by the
+    /// Calls `leaf(i, j)` for every pair of primitives whose own boxes overlap by the
     /// conservative test (a superset of the pairs whose exact boxes overlap or lie within
     /// the tolerance), in descent order, until it breaks. The descent gathers pairs in
     /// batches, so it may run a few dozen box tests past the pair that breaks.
@@ -140,8 +140,17 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         &self,
         mut leaf: impl FnMut(u32, u32) -> ControlFlow<()>,
     ) -> (ControlFlow<()>, Stats) {
+        // A layout that stores primitives' boxes holds them on its grid, a little larger:
+        // the pairs it passes are tested again on the primitives' own boxes.
+        let stored = A::Nodes::STORES_PRIMITIVES || B::Nodes::STORES_PRIMITIVES;
         self.descend(LANES, &mut |pairs| {
             for &(i, j) in pairs {
+                if stored {
+                    let ((ca, ea), (cb, eb)) = (self.a.primitive_box(i), self.b.primitive_box(j));
+                    if !self.relative.overlaps_ce(ca, ea, cb, eb) {
+                        continue;
+                    }
+                }
                 leaf(i, j)?;
             }
             ControlFlow::Continue(())
