@@ -241,57 +241,48 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             // tests at once, each kept by a count, not a branch.
             stack.reserve(4);
             let fixed = Lanes::splat(cf, ef);
-            // What each new pair does next, decided in lanes: split the side with the larger
-            // extent (summed), never a primitive; two primitives are a leaf.
             let fixed_sum = Vec4::splat(ef.x + ef.y + ef.z);
-            if kind == Kind::SplitA {
-                let below = Below::new(la, ra.index(), prim_a);
-                stats.node_pairs += u64::from(below.valid.count_ones());
-                let apart = rel.apart_lanes(&rel.on_a_lanes(&fixed), &below.lanes)
+            // The boxes below the split node are `A`'s when it splits `A`, and the fixed box
+            // `B`'s. What each new pair does next: split the side with the larger extent
+            // (summed), never a primitive; two primitives are a leaf.
+            let split_a = kind == Kind::SplitA;
+            let (below, apart, leaf_lanes, split_next_a);
+            if split_a {
+                below = Below::new(la, ra.index(), prim_a);
+                apart = rel.apart_lanes(&rel.on_a_lanes(&fixed), &below.lanes)
                     | rel.apart_lanes(&rel.on_b_lanes(&below.lanes), &fixed);
-                let kid_prim = below.primitives();
-                let fixed_prim = if rb.is_primitive() { 0b1111 } else { 0 };
+                let (kid_prim, fixed_prim) = (below.primitives(), all_or_none(rb.is_primitive()));
                 let larger = below.extent_sums().cmpge(fixed_sum).bitmask();
-                let split_a = !kid_prim & (fixed_prim | larger);
-                for (l, kid) in below.kids.iter().enumerate().rev() {
-                    let (ca, ea) = (kid.center, kid.extent);
-                    let mut keep = (below.valid & !apart) >> l & 1 != 0;
-                    let leaf = (kid_prim & fixed_prim) >> l & 1 != 0;
-                    if self.cross_near_leaves && keep && leaf {
-                        keep = !rel.roots_separated(ca, ea, cf, ef, margin);
-                    }
-                    // Splitting `A` next carries `B`'s box, the fixed one.
-                    let split = split_a >> l & 1 != 0;
-                    let carried = (
-                        Vec3A::select(BVec3A::splat(split), cf, ca),
-                        Vec3A::select(BVec3A::splat(split), ef, ea),
-                    );
-                    stack.put((kid.r, rb, Kind::of(leaf, split)), carried, keep);
-                }
+                leaf_lanes = kid_prim & fixed_prim;
+                split_next_a = !kid_prim & (fixed_prim | larger);
             } else {
-                let below = Below::new(lb, rb.index(), prim_b);
-                stats.node_pairs += u64::from(below.valid.count_ones());
-                let apart = rel.apart_lanes(&rel.on_a_lanes(&below.lanes), &fixed)
+                below = Below::new(lb, rb.index(), prim_b);
+                apart = rel.apart_lanes(&rel.on_a_lanes(&below.lanes), &fixed)
                     | rel.apart_lanes(&rel.on_b_lanes(&fixed), &below.lanes);
-                let kid_prim = below.primitives();
-                let fixed_prim = if ra.is_primitive() { 0b1111 } else { 0 };
+                let (kid_prim, fixed_prim) = (below.primitives(), all_or_none(ra.is_primitive()));
                 let larger = below.extent_sums().cmpgt(fixed_sum).bitmask();
-                let split_a = !fixed_prim & (kid_prim | !larger);
-                for (l, kid) in below.kids.iter().enumerate().rev() {
-                    let (cb, eb) = (kid.center, kid.extent);
-                    let mut keep = (below.valid & !apart) >> l & 1 != 0;
-                    let leaf = (kid_prim & fixed_prim) >> l & 1 != 0;
-                    if self.cross_near_leaves && keep && leaf {
-                        keep = !rel.roots_separated(cf, ef, cb, eb, margin);
-                    }
-                    // Splitting `A` next carries `B`'s box, the kid's.
-                    let split = split_a >> l & 1 != 0;
-                    let carried = (
-                        Vec3A::select(BVec3A::splat(split), cb, cf),
-                        Vec3A::select(BVec3A::splat(split), eb, ef),
-                    );
-                    stack.put((ra, kid.r, Kind::of(leaf, split)), carried, keep);
+                leaf_lanes = kid_prim & fixed_prim;
+                split_next_a = !fixed_prim & (kid_prim | !larger);
+            }
+            stats.node_pairs += u64::from(below.valid.count_ones());
+            for (l, kid) in below.kids.iter().enumerate().rev() {
+                let (a, ca, ea, b, cb, eb) = if split_a {
+                    (kid.r, kid.center, kid.extent, rb, cf, ef)
+                } else {
+                    (ra, cf, ef, kid.r, kid.center, kid.extent)
+                };
+                let mut keep = (below.valid & !apart) >> l & 1 != 0;
+                let leaf = leaf_lanes >> l & 1 != 0;
+                if self.cross_near_leaves && keep && leaf {
+                    keep = !rel.roots_separated(ca, ea, cb, eb, margin);
                 }
+                // Splitting `A` next carries `B`'s box, and splitting `B` carries `A`'s.
+                let split = split_next_a >> l & 1 != 0;
+                let carried = (
+                    Vec3A::select(BVec3A::splat(split), cb, ca),
+                    Vec3A::select(BVec3A::splat(split), eb, ea),
+                );
+                stack.put((a, b, Kind::of(leaf, split)), carried, keep);
             }
         }
         stats.leaf_pairs += found as u64;
@@ -348,6 +339,12 @@ impl Below {
             valid: v0 | v1 << 2,
         }
     }
+}
+
+/// Every lane's bit when `on`, none otherwise.
+#[inline(always)]
+fn all_or_none(on: bool) -> u32 {
+    if on { 0b1111 } else { 0 }
 }
 
 /// The descent's consumer: called once per batch of pairs of primitives whose boxes
