@@ -43,16 +43,19 @@ pub(crate) struct Solid {
     pub triangles: Vec<[usize; 3]>,
     /// Each triangle's doubled area vector `(b − a) × (c − a)`, outward.
     pub areas: Vec<DVec3>,
-    /// Each edge once, with its two triangles.
+    /// Each edge once, with its two triangles, cell by cell of [`Solid::cells`].
     edges: Vec<Edge>,
+    /// The edges in cells of nearby face normals, for [`Solid::outline`].
+    cells: Vec<Cell>,
     /// The vertices joined to vertex `v` by an edge: `links[starts[v]..starts[v + 1]]`.
     starts: Vec<usize>,
     links: Vec<usize>,
-    /// The area vectors' coordinate columns, and `2^-40` times each triangle's scale
-    /// `|b − a|₁·|c − a|₁` (which bounds the rounding of its area vector), in lanes of
-    /// [`LANES`] (the last padded with zeros), for [`Solid::shadow`] and [`Solid::outline`].
+    /// The area vectors' coordinate columns in lanes of [`LANES`] (the last padded with
+    /// zeros), for [`Solid::shadow`].
     columns: [Vec<[f64; LANES]>; 3],
-    bands: Vec<[f64; LANES]>,
+    /// `2^-40` times each triangle's scale `|b − a|₁·|c − a|₁`, which bounds the rounding of
+    /// its area vector ([`Solid::outline`]).
+    bands: Vec<f64>,
 }
 
 /// An edge of a solid hull: its two triangles, and its first vertex as it runs in each
@@ -63,8 +66,84 @@ struct Edge {
     tails: [usize; 2],
 }
 
-/// Triangles per lane group of [`Solid::shadow`] and [`Solid::outline`].
+/// Hulls of at most this many vertices are measured by a scan of every vertex, not by
+/// climbs ([`Solid::extent`]): the fast fit's hulls of 26 extremal points.
+const SCANNED: usize = 32;
+
+/// Triangles per lane group of [`Solid::shadow`].
 const LANES: usize = 4;
+
+/// A cell of edges ([`Solid::outline`]): those up to `end` in [`Solid::edges`] (from the
+/// last cell's end), with bounds `lo <= u <= hi` on the unit normals `u = A/|A|` of their
+/// triangles and the largest ratio `band/|A|` among them (infinite when one has no area).
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    end: usize,
+    lo: DVec3,
+    hi: DVec3,
+    reach: f64,
+}
+
+/// About how many edges a cell holds: the outline tests every cell and every edge of the
+/// cells it cannot rule out.
+const CELL_EDGES: f64 = 32.0;
+
+/// A cell is ruled out when its range of `n·u` clears its `reach` by this much, far more
+/// than the rounding of `n·u` and of the triangles' own side tests (a few `2^-53`).
+const CELL_MARGIN: f64 = pow2(-30);
+
+/// Sorts `edges` into cells of nearby normals and returns the cells: each edge goes by the
+/// sum `m` of its triangles' unit normals to a cell of a grid on the cube's face that `m`
+/// points through (`side × side` cells a face, about [`CELL_EDGES`] edges a cell). Only
+/// the bounds matter for the outline, not which cell an edge went to: an edge with no
+/// direction (a triangle with no area) goes to the first.
+fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
+    let units: Vec<DVec3> = areas
+        .iter()
+        .map(|a| a.try_normalize().unwrap_or(DVec3::ZERO))
+        .collect();
+    let side = ((edges.len() as f64 / (6.0 * CELL_EDGES)).sqrt().ceil() as usize).clamp(1, 64);
+    let cell_of = |e: &Edge| {
+        let m = units[e.faces[0]] + units[e.faces[1]];
+        let k = m.abs().max_position();
+        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+        let top = m[k].abs();
+        if top == 0.0 {
+            return 0;
+        }
+        let at = |x: f64| (((x / top + 1.0) * 0.5 * side as f64) as usize).min(side - 1);
+        let face = 2 * k + usize::from(m[k] < 0.0);
+        (face * side + at(m[a])) * side + at(m[b])
+    };
+    let mut keyed: Vec<(usize, Edge)> = edges.iter().map(|e| (cell_of(e), *e)).collect();
+    keyed.sort_by_key(|&(key, _)| key);
+    edges.clear();
+    let mut cells: Vec<Cell> = Vec::new();
+    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        let mut cell = Cell {
+            end: edges.len() + run.len(),
+            lo: DVec3::INFINITY,
+            hi: DVec3::NEG_INFINITY,
+            reach: 0.0,
+        };
+        for &(_, edge) in run {
+            for t in edge.faces {
+                let area = areas[t].length();
+                cell.lo = cell.lo.min(units[t]);
+                cell.hi = cell.hi.max(units[t]);
+                let reach = if area > 0.0 {
+                    bands[t] / area
+                } else {
+                    f64::INFINITY
+                };
+                cell.reach = cell.reach.max(reach);
+            }
+            edges.push(edge);
+        }
+        cells.push(cell);
+    }
+    cells
+}
 
 impl Solid {
     /// The hull from its vertices, triangles and their neighbours (`neighbors[t][k]`: the
@@ -111,8 +190,8 @@ impl Solid {
                 .collect()
         };
         let columns = [0, 1, 2].map(|k| lanes(&|t| areas[t][k]));
-        let bands = lanes(&|t| pow2(-40) * scales[t]);
-        let edges = (0..triangles.len())
+        let bands: Vec<f64> = scales.iter().map(|&s| pow2(-40) * s).collect();
+        let mut edges = (0..triangles.len())
             .flat_map(|t| (0..3).map(move |k| (t, k)))
             .filter(|&(t, k)| t < neighbors[t][k])
             .map(|(t, k)| Edge {
@@ -120,11 +199,13 @@ impl Solid {
                 tails: [triangles[t][k], triangles[t][(k + 1) % 3]],
             })
             .collect();
+        let cells = cells(&mut edges, &areas, &bands);
         Self {
             vertices,
             triangles,
             areas,
             edges,
+            cells,
             starts,
             links,
             columns,
@@ -189,7 +270,20 @@ impl Solid {
 
     /// The extent `max − min` of the hull along `axis`, by two climbs from the vertices in
     /// `from` (the lowest and the highest along a nearby axis), which are updated.
+    ///
+    /// A hull of at most [`SCANNED`] vertices is scanned instead: every vertex, in
+    /// branch-free order, costs less than a climb's unpredictable steps; `from` is then left
+    /// as it is.
     pub fn extent(&self, axis: DVec3, from: &mut [usize; 2]) -> f64 {
+        if self.vertices.len() <= SCANNED {
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for v in &self.vertices {
+                let h = v.dot(axis);
+                lo = if h < lo { h } else { lo };
+                hi = if h > hi { h } else { hi };
+            }
+            return (hi - lo).max(0.0);
+        }
         from[0] = self.extreme(-axis, from[0]);
         from[1] = self.extreme(axis, from[1]);
         let [lo, hi] = from.map(|i| self.vertices[i].dot(axis));
@@ -213,37 +307,43 @@ impl Solid {
     /// cannot all face `n` (then `n·d > 0`), nor all face strictly away from it (then
     /// `n·d < 0`): so either one is edge-on, or both kinds meet at an edge at `v` (the
     /// triangles around `v` form a cycle).
+    ///
+    /// Only the edges of cells that `n` may split are tested ([`cells`]): over a cell's box,
+    /// `n·u` ranges over `[least, most]`, and `n·A` of its triangles is `|A|·n·u` up to
+    /// their rounding; when `least` exceeds the cell's largest `band/|A|` by
+    /// [`CELL_MARGIN`], all of its triangles face `n`, and when `most` is below its negative,
+    /// all face away: either way it holds no rim edge and no edge-on triangle. Every triangle
+    /// has its edges in cells, so the outline is the one a test of every edge gives (a unit
+    /// test checks it), at the cost of a few cells' edges: those whose normals lie near the
+    /// great circle orthogonal to `n`.
     pub fn outline(&self, n: DVec3) -> Vec<usize> {
-        // Each triangle's side in lanes: 1 facing `n`, 0 edge-on, -1 facing away.
-        let [x, y, z] = &self.columns;
-        let sides: Vec<[i8; LANES]> = crate::simd::plain(
-            #[inline(always)]
-            || {
-                (0..x.len())
-                    .map(|g| {
-                        let mut side = [0; LANES];
-                        for j in 0..LANES {
-                            let h = x[g][j] * n.x + y[g][j] * n.y + z[g][j] * n.z;
-                            let band = self.bands[g][j];
-                            side[j] = i8::from(h > band) - i8::from(h < -band);
-                        }
-                        side
-                    })
-                    .collect()
-            },
-        );
-        let sides = &sides.as_flattened()[..self.triangles.len()];
-        // Few edges are on the rim and few triangles edge-on: both tests are predictable.
+        // 1 facing `n`, 0 edge-on, -1 facing away.
+        let side = |t: usize| {
+            let h = self.areas[t].dot(n);
+            i8::from(h > self.bands[t]) - i8::from(h < -self.bands[t])
+        };
         let mut outline = Vec::new();
-        for edge in &self.edges {
-            let [a, b] = edge.faces.map(|t| sides[t] == 1);
-            if a != b {
-                outline.push(edge.tails[usize::from(b)]);
+        let mut start = 0;
+        for cell in &self.cells {
+            let edges = &self.edges[start..cell.end];
+            start = cell.end;
+            // The range of `n·u` over the cell's box, and the side it leaves its triangles on.
+            let least = (n * DVec3::select(n.cmpge(DVec3::ZERO), cell.lo, cell.hi)).element_sum();
+            let most = (n * DVec3::select(n.cmpge(DVec3::ZERO), cell.hi, cell.lo)).element_sum();
+            let clear = cell.reach + CELL_MARGIN;
+            if least > clear || most < -clear {
+                continue;
             }
-        }
-        for (t, &side) in sides.iter().enumerate() {
-            if side == 0 {
-                outline.extend(self.triangles[t]);
+            for edge in edges {
+                let sides = edge.faces.map(side);
+                if (sides[0] == 1) != (sides[1] == 1) {
+                    outline.push(edge.tails[usize::from(sides[1] == 1)]);
+                }
+                for (k, &s) in sides.iter().enumerate() {
+                    if s == 0 {
+                        outline.extend(self.triangles[edge.faces[k]]);
+                    }
+                }
             }
         }
         outline
@@ -790,6 +890,57 @@ mod tests {
         full.run();
         assert_eq!(filtered, vertices(full.into_hull()));
         assert_eq!(filtered.len(), 667, "every point on the sphere");
+    }
+
+    /// The outline that tests only the cells `n` may split holds the same vertices as a test
+    /// of every edge and every triangle, on a ball (many cells), a cube (coplanar faces,
+    /// edge-on along the axes) and a sliver-thin slab.
+    #[test]
+    fn the_outline_of_the_cells_is_that_of_every_edge() {
+        let mut next = crate::num::uniform(0x2545_f491_4f6c_dd1d);
+        let ball: Vec<DVec3> = (0..1000)
+            .map(|_| DVec3::new(next(), next(), next()).normalize())
+            .map(|p| p.as_vec3().as_dvec3())
+            .collect();
+        let cube: Vec<DVec3> = (0..64)
+            .map(|k| DVec3::new((k % 4) as f64, (k / 4 % 4) as f64, (k / 16) as f64))
+            .collect();
+        let slab: Vec<DVec3> = (0..400)
+            .map(|_| DVec3::new(next(), next(), 1e-6 * next()))
+            .map(|p| p.as_vec3().as_dvec3())
+            .collect();
+        for points in [ball, cube, slab] {
+            let Hull::Solid(hull) = convex_hull(&points) else {
+                panic!("solid");
+            };
+            assert!(hull.cells.len() > 1);
+            let mut directions: Vec<DVec3> = hull.areas.iter().map(|a| a.normalize()).collect();
+            directions.extend([DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE.normalize()]);
+            directions.extend((0..50).map(|_| DVec3::new(next(), next(), next()).normalize()));
+            for n in directions {
+                let side = |t: usize| {
+                    let h = hull.areas[t].dot(n);
+                    i8::from(h > hull.bands[t]) - i8::from(h < -hull.bands[t])
+                };
+                let mut every: Vec<usize> = hull
+                    .edges
+                    .iter()
+                    .filter(|e| (side(e.faces[0]) == 1) != (side(e.faces[1]) == 1))
+                    .map(|e| e.tails[usize::from(side(e.faces[1]) == 1)])
+                    .chain(
+                        (0..hull.triangles.len())
+                            .filter(|&t| side(t) == 0)
+                            .flat_map(|t| hull.triangles[t]),
+                    )
+                    .collect();
+                let mut found = hull.outline(n);
+                for list in [&mut every, &mut found] {
+                    list.sort_unstable();
+                    list.dedup();
+                }
+                assert_eq!(found, every, "along {n}");
+            }
+        }
     }
 
     /// The outline's shadow is the whole hull's: seen along the face normals, the axes
