@@ -98,10 +98,18 @@ const CELL_MARGIN: f64 = pow2(-30);
 /// the bounds matter for the outline, not which cell an edge went to: an edge with no
 /// direction (a triangle with no area) goes to the first.
 fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
-    let units: Vec<DVec3> = areas
+    let (units, reaches): (Vec<DVec3>, Vec<f64>) = areas
         .iter()
-        .map(|a| a.try_normalize().unwrap_or(DVec3::ZERO))
-        .collect();
+        .zip(bands)
+        .map(|(a, band)| {
+            let area = a.length();
+            if area > 0.0 {
+                (*a / area, band / area)
+            } else {
+                (DVec3::ZERO, f64::INFINITY)
+            }
+        })
+        .unzip();
     let side = ((edges.len() as f64 / (6.0 * CELL_EDGES)).sqrt().ceil() as usize).clamp(1, 64);
     let cell_of = |e: &Edge| {
         let m = units[e.faces[0]] + units[e.faces[1]];
@@ -115,30 +123,41 @@ fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
         let face = 2 * k + usize::from(m[k] < 0.0);
         (face * side + at(m[a])) * side + at(m[b])
     };
-    let mut keyed: Vec<(usize, Edge)> = edges.iter().map(|e| (cell_of(e), *e)).collect();
-    keyed.sort_by_key(|&(key, _)| key);
-    edges.clear();
+    // A counting sort by cell: the cells are few and the edges many.
+    let keys: Vec<usize> = edges.iter().map(cell_of).collect();
+    let mut ends = vec![0; 6 * side * side];
+    for &key in &keys {
+        ends[key] += 1;
+    }
+    for key in 1..ends.len() {
+        ends[key] += ends[key - 1];
+    }
+    let mut sorted = edges.clone();
+    for (&key, &edge) in keys.iter().zip(edges.iter()).rev() {
+        ends[key] -= 1;
+        sorted[ends[key]] = edge;
+    }
+    *edges = sorted;
+    // Now `ends[key]` is where the cell starts; empty cells are left out.
+    let starts = ends;
     let mut cells: Vec<Cell> = Vec::new();
-    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+    for (key, &start) in starts.iter().enumerate() {
+        let end = starts.get(key + 1).copied().unwrap_or(edges.len());
+        if start == end {
+            continue;
+        }
         let mut cell = Cell {
-            end: edges.len() + run.len(),
+            end,
             lo: DVec3::INFINITY,
             hi: DVec3::NEG_INFINITY,
             reach: 0.0,
         };
-        for &(_, edge) in run {
+        for edge in &edges[start..end] {
             for t in edge.faces {
-                let area = areas[t].length();
                 cell.lo = cell.lo.min(units[t]);
                 cell.hi = cell.hi.max(units[t]);
-                let reach = if area > 0.0 {
-                    bands[t] / area
-                } else {
-                    f64::INFINITY
-                };
-                cell.reach = cell.reach.max(reach);
+                cell.reach = cell.reach.max(reaches[t]);
             }
-            edges.push(edge);
         }
         cells.push(cell);
     }

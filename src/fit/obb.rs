@@ -507,25 +507,43 @@ fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> 
 /// `most` of them.
 fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
     let areas = &hull.areas;
-    // Each face's direction key and index, by key then index: the first face of a
-    // direction gives its normal.
-    let mut faces: Vec<([i64; 3], usize)> = (0..areas.len())
-        .filter_map(|t| {
-            let unit = areas[t].try_normalize()?;
-            let key = (unit * f64::from(1u32 << 24)).round().as_i64vec3();
-            Some((key.to_array(), t))
-        })
-        .collect();
-    faces.sort_unstable();
-    let mut normals: Vec<(f64, [i64; 3], DVec3)> = faces
-        .chunk_by(|a, b| a.0 == b.0)
-        .map(|run| {
-            let area = run.iter().map(|&(_, t)| areas[t].length()).sum();
-            (area, run[0].0, areas[run[0].1].normalize())
-        })
-        .collect();
+    // The directions, each with its summed area (in face order), its key and its first
+    // face, which gives its normal. They are found in a hash table with open addressing,
+    // keyed by the direction: sorting every face by its key cost more than the rest of the
+    // rectangles' bounds.
+    let slots = (2 * areas.len()).next_power_of_two().max(2);
+    let shift = 64 - slots.trailing_zeros();
+    let mut table = vec![usize::MAX; slots];
+    let mut normals: Vec<(f64, [i64; 3], usize)> = Vec::new();
+    for (t, area) in areas.iter().enumerate() {
+        let Some(unit) = area.try_normalize() else {
+            continue;
+        };
+        let key = (unit * f64::from(1u32 << 24))
+            .round()
+            .as_i64vec3()
+            .to_array();
+        let hash = key.iter().fold(0u64, |h, &k| {
+            (h ^ k as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        });
+        let mut slot = (hash >> shift) as usize;
+        loop {
+            match table[slot] {
+                usize::MAX => {
+                    table[slot] = normals.len();
+                    normals.push((area.length(), key, t));
+                    break;
+                }
+                d if normals[d].1 == key => {
+                    normals[d].0 += area.length();
+                    break;
+                }
+                _ => slot = (slot + 1) & (slots - 1),
+            }
+        }
+    }
     // Largest first, ties in key order; only the first `most` are sorted.
-    let order = |a: &(f64, [i64; 3], DVec3), b: &(f64, [i64; 3], DVec3)| {
+    let order = |a: &(f64, [i64; 3], usize), b: &(f64, [i64; 3], usize)| {
         b.0.total_cmp(&a.0).then(a.1.cmp(&b.1))
     };
     if normals.len() > most {
@@ -533,7 +551,10 @@ fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
         normals.truncate(most);
     }
     normals.sort_unstable_by(order);
-    normals.into_iter().map(|(_, _, n)| n).collect()
+    normals
+        .into_iter()
+        .map(|(_, _, t)| areas[t].normalize())
+        .collect()
 }
 
 /// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
