@@ -86,7 +86,7 @@ struct Cell {
 
 /// About how many edges a cell holds: the outline tests every cell and every edge of the
 /// cells it cannot rule out.
-const CELL_EDGES: f64 = 32.0;
+const CELL_EDGES: f64 = 16.0;
 
 /// A cell is ruled out when its range of `n·u` clears its `reach` by this much, far more
 /// than the rounding of `n·u` and of the triangles' own side tests (a few `2^-53`).
@@ -358,9 +358,11 @@ impl Solid {
                 if (sides[0] == 1) != (sides[1] == 1) {
                     outline.push(edge.tails[usize::from(sides[1] == 1)]);
                 }
-                for (k, &s) in sides.iter().enumerate() {
-                    if s == 0 {
-                        outline.extend(self.triangles[edge.faces[k]]);
+                // An edge-on triangle, once: from its first edge.
+                for k in 0..2 {
+                    let triangle = self.triangles[edge.faces[k]];
+                    if sides[k] == 0 && edge.tails[k] == triangle[0] {
+                        outline.extend(triangle);
                     }
                 }
             }
