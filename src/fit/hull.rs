@@ -359,9 +359,9 @@ impl Solid {
                     outline.push(edge.tails[usize::from(sides[1] == 1)]);
                 }
                 // An edge-on triangle, once: from its first edge.
-                for k in 0..2 {
-                    let triangle = self.triangles[edge.faces[k]];
-                    if sides[k] == 0 && edge.tails[k] == triangle[0] {
+                for ((side, face), tail) in sides.into_iter().zip(edge.faces).zip(edge.tails) {
+                    let triangle = self.triangles[face];
+                    if side == 0 && tail == triangle[0] {
                         outline.extend(triangle);
                     }
                 }
