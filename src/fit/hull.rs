@@ -53,17 +53,17 @@ pub(crate) struct Solid {
     /// The area vectors' coordinate columns in lanes of [`LANES`] (the last padded with
     /// zeros), for [`Solid::shadow`].
     columns: [Vec<[f64; LANES]>; 3],
-    /// `2^-40` times each triangle's scale `|b − a|₁·|c − a|₁`, which bounds the rounding of
-    /// its area vector ([`Solid::outline`]).
-    bands: Vec<f64>,
 }
 
 /// An edge of a solid hull: its two triangles, and its first vertex as it runs in each
-/// (the triangles run it in opposite directions).
+/// (the triangles run it in opposite directions); with copies of the triangles' area vectors
+/// and bands, so that [`Solid::outline`] reads a cell's edges in one sweep of memory.
 #[derive(Clone, Copy, Debug)]
 struct Edge {
     faces: [usize; 2],
     tails: [usize; 2],
+    areas: [DVec3; 2],
+    bands: [f64; 2],
 }
 
 /// Hulls of at most this many vertices are measured by a scan of every vertex, not by
@@ -218,13 +218,20 @@ impl Solid {
                 .collect()
         };
         let columns = [0, 1, 2].map(|k| lanes(&|t| areas[t][k]));
+        // `2^-40` times each triangle's scale `|b − a|₁·|c − a|₁`, which bounds the
+        // rounding of its area vector ([`Solid::outline`]).
         let bands: Vec<f64> = scales.iter().map(|&s| pow2(-40) * s).collect();
         let mut edges = (0..triangles.len())
             .flat_map(|t| (0..3).map(move |k| (t, k)))
             .filter(|&(t, k)| t < neighbors[t][k])
-            .map(|(t, k)| Edge {
-                faces: [t, neighbors[t][k]],
-                tails: [triangles[t][k], triangles[t][(k + 1) % 3]],
+            .map(|(t, k)| {
+                let faces = [t, neighbors[t][k]];
+                Edge {
+                    faces,
+                    tails: [triangles[t][k], triangles[t][(k + 1) % 3]],
+                    areas: faces.map(|f| areas[f]),
+                    bands: faces.map(|f| bands[f]),
+                }
             })
             .collect();
         let cells = cells(&mut edges, &areas, &bands);
@@ -237,7 +244,6 @@ impl Solid {
             starts,
             links,
             columns,
-            bands,
         }
     }
 
@@ -346,9 +352,9 @@ impl Solid {
     /// great circle orthogonal to `n`.
     pub fn outline(&self, n: DVec3) -> Vec<usize> {
         // 1 facing `n`, 0 edge-on, -1 facing away.
-        let side = |t: usize| {
-            let h = self.areas[t].dot(n);
-            i8::from(h > self.bands[t]) - i8::from(h < -self.bands[t])
+        let side = |area: DVec3, band: f64| {
+            let h = area.dot(n);
+            i8::from(h > band) - i8::from(h < -band)
         };
         let mut outline = Vec::new();
         let mut start = 0;
@@ -363,7 +369,7 @@ impl Solid {
                 continue;
             }
             for edge in edges {
-                let sides = edge.faces.map(side);
+                let sides = [0, 1].map(|k| side(edge.areas[k], edge.bands[k]));
                 if (sides[0] == 1) != (sides[1] == 1) {
                     outline.push(edge.tails[usize::from(sides[1] == 1)]);
                 }
@@ -948,10 +954,16 @@ mod tests {
             let mut directions: Vec<DVec3> = hull.areas.iter().map(|a| a.normalize()).collect();
             directions.extend([DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE.normalize()]);
             directions.extend((0..50).map(|_| DVec3::new(next(), next(), next()).normalize()));
+            let mut bands = vec![0.0; hull.triangles.len()];
+            for edge in &hull.edges {
+                for k in 0..2 {
+                    bands[edge.faces[k]] = edge.bands[k];
+                }
+            }
             for n in directions {
                 let side = |t: usize| {
                     let h = hull.areas[t].dot(n);
-                    i8::from(h > hull.bands[t]) - i8::from(h < -hull.bands[t])
+                    i8::from(h > bands[t]) - i8::from(h < -bands[t])
                 };
                 let mut every: Vec<usize> = hull
                     .edges
