@@ -86,7 +86,7 @@ struct Cell {
 
 /// About how many edges a cell holds: the outline tests every cell and every edge of the
 /// cells it cannot rule out.
-const CELL_EDGES: f64 = 16.0;
+const CELL_EDGES: usize = 16;
 
 /// A cell is ruled out when its range of `n·u` clears its `reach` by this much, far more
 /// than the rounding of `n·u` and of the triangles' own side tests (a few `2^-53`).
@@ -99,7 +99,7 @@ const CELL_MARGIN: f64 = pow2(-30);
 /// direction (a triangle with no area) goes to the first. A hull of few edges (the fast
 /// fit's) gets one cell that is never ruled out.
 fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
-    if edges.len() <= 6 * CELL_EDGES as usize {
+    if edges.len() <= 6 * CELL_EDGES {
         return vec![Cell {
             end: edges.len(),
             lo: DVec3::NEG_ONE,
@@ -119,7 +119,10 @@ fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
             }
         })
         .unzip();
-    let side = ((edges.len() as f64 / (6.0 * CELL_EDGES)).sqrt().ceil() as usize).clamp(1, 64);
+    // The least side (at most 64) whose cells hold at most `CELL_EDGES` edges each on average.
+    let side = (1..64)
+        .find(|&side| 6 * side * side * CELL_EDGES >= edges.len())
+        .unwrap_or(64);
     let cell_of = |e: &Edge| {
         let m = units[e.faces[0]] + units[e.faces[1]];
         let k = m.abs().max_position();
