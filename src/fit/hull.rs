@@ -224,19 +224,21 @@ impl Solid {
         // `2^-40` times each triangle's scale `|b − a|₁·|c − a|₁`, which bounds the
         // rounding of its area vector ([`Solid::outline`]).
         let bands: Vec<f64> = scales.iter().map(|&s| pow2(-40) * s).collect();
-        let mut edges = (0..triangles.len())
-            .flat_map(|t| (0..3).map(move |k| (t, k)))
-            .filter(|&(t, k)| t < neighbors[t][k])
-            .map(|(t, k)| {
+        // Each edge once, from the triangle of lower index (a closed surface: `3T/2` edges).
+        let mut edges = Vec::with_capacity(3 * triangles.len() / 2);
+        for (t, triangle) in triangles.iter().enumerate() {
+            for k in 0..3 {
                 let faces = [t, neighbors[t][k]];
-                Edge {
-                    faces,
-                    tails: [triangles[t][k], triangles[t][(k + 1) % 3]],
-                    areas: faces.map(|f| areas[f]),
-                    bands: faces.map(|f| bands[f]),
+                if faces[0] < faces[1] {
+                    edges.push(Edge {
+                        faces,
+                        tails: [triangle[k], triangle[(k + 1) % 3]],
+                        areas: faces.map(|f| areas[f]),
+                        bands: faces.map(|f| bands[f]),
+                    });
                 }
-            })
-            .collect();
+            }
+        }
         let cells = cells(&mut edges, &areas, &bands);
         Self {
             vertices,
