@@ -5,7 +5,7 @@ use super::bound::{Bounded, largest, segment_distance};
 use super::cloud::{self, exact};
 use super::eigen::principal_axes;
 use super::obb::{Obb3, tight_frames};
-use super::search::compass_search;
+use super::search::{compass_search, nelder_mead};
 use super::{Fit, FitError};
 use crate::aabb::Aabb3;
 use crate::num::sqrt;
@@ -256,5 +256,47 @@ fn tight_capsule(points: &[Vec3]) -> Capsule64 {
         })
     });
     let baseline = [fast_capsule(points), pca_capsule(points)];
-    smallest(searched.chain(baseline))
+    let mut best = smallest(searched.chain(baseline));
+    // The simplex settles on ridges of the volume: restarted from where it stopped, with
+    // a smaller first step, it goes on down.
+    for round in 0..REFINEMENTS {
+        let next = refined(support, best, 0.1 / (1 + round) as f64);
+        if next.volume() >= best.volume() {
+            break;
+        }
+        best = next;
+    }
+    best
+}
+
+/// Restarts of the tight capsule's five-way local search, at most.
+const REFINEMENTS: usize = 8;
+
+/// A local search from `start` over all five degrees of freedom at once: the axis's
+/// direction, where it crosses the plane across it, and the radius (at least the largest
+/// distance of a point from the axis). The search over directions fixes the axis through
+/// the enclosing circle's center; a capsule with a wider radius and shorter caps may sit
+/// off it.
+fn refined(points: &[DVec3], start: Capsule64, step: f64) -> Capsule64 {
+    let Some(seed) = (start.b - start.a).try_normalize() else {
+        return start;
+    };
+    let (e1, e2) = seed.any_orthonormal_pair();
+    let (middle, radius) = (0.5 * (start.a + start.b), start.radius);
+    let capsule = |t: [f64; 5]| {
+        let dir = (seed + e1 * t[0] + e2 * t[1]).normalize();
+        let origin = middle + (e1 * t[2] + e2 * t[3]) * radius;
+        let reach = points
+            .iter()
+            .map(|&p| (p - origin).reject_from_normalized(dir).length_squared())
+            .fold(0.0, f64::max);
+        capped(
+            points,
+            origin,
+            dir,
+            (radius * (1.0 + t[4])).max(sqrt(reach)),
+        )
+    };
+    let (t, _) = nelder_mead(|t| capsule(t).volume(), step, 1e-12, 3000);
+    capsule(t)
 }
