@@ -363,7 +363,7 @@ fn check_targets(
     // Either 0.7 of the PCA capsule, or a proof that the optimum is not much smaller than
     // the tight capsule: a lower bound over all axis directions within 5% of it.
     let (tight, pca) = (volume_of(capsule, "Tight"), volume_of(capsule, "Pca"));
-    let work = if quick() { 200_000 } else { 200_000_000 };
+    let work = if quick() { 200_000 } else { 4_000_000_000 };
     let floor = capsule_bound::capsule_lower_bound(points, work);
     out.push(Target {
         text: format!(
