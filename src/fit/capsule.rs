@@ -297,6 +297,6 @@ fn refined(points: &[DVec3], start: Capsule64, step: f64) -> Capsule64 {
             (radius * (1.0 + t[4])).max(sqrt(reach)),
         )
     };
-    let (t, _) = nelder_mead(|t| capsule(t).volume(), step, 1e-12, 3000);
+    let (t, _) = nelder_mead(|t| capsule(t).volume(), step, 1e-9, 1000);
     capsule(t)
 }
