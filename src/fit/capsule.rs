@@ -52,7 +52,7 @@ impl Capsule {
     /// the major principal axis, centered by the minimum enclosing circle of the points
     /// projected across it;
     /// [`Fit::Tight`] on a direction optimised from the tight box's axes, with the radius
-    /// optimised too. All with the shortest segment (minimal caps), and the radius then
+    /// optimised too, then a local search over direction, axis position and radius at once. All with the shortest segment (minimal caps), and the radius then
     /// certified from every point.
     ///
     /// # Errors
@@ -240,7 +240,7 @@ fn best_radius(points: &[DVec3], dir: DVec3) -> Capsule64 {
 
 /// The tight fit: from each axis of the tight box's candidate frames, a compass search
 /// over directions `normalize(d + θ0 e1 + θ1 e2)`, each direction with its best radius;
-/// never worse than the fast and PCA capsules.
+/// the best of those and of the fast and PCA capsules is then [`refined`].
 fn tight_capsule(points: &[Vec3]) -> Capsule64 {
     let distinct: Vec<DVec3> = cloud::unique(points).into_iter().map(exact).collect();
     let mut tight = tight_frames(&distinct);
