@@ -52,8 +52,9 @@ impl Capsule {
     /// the major principal axis, centered by the minimum enclosing circle of the points
     /// projected across it;
     /// [`Fit::Tight`] on a direction optimised from the tight box's axes, with the radius
-    /// optimised too, then a local search over direction, axis position and radius at once. All with the shortest segment (minimal caps), and the radius then
-    /// certified from every point.
+    /// optimised too, then a local search over direction, axis position and radius at once.
+    /// All with the shortest segment (minimal caps), and the radius then certified from
+    /// every point.
     ///
     /// # Errors
     /// [`FitError::Empty`] for no points, [`FitError::NonFinite`] for a non-finite point,

@@ -46,13 +46,18 @@ pub(crate) fn compass_search<const N: usize>(
 /// contraction fails. Unlike the compass search it moves along diagonals, so it follows
 /// the ridges where two terms of a maximum trade off (a capsule's cap against its radius).
 /// It stops after `max_evals` evaluations or once the values of the simplex agree within
-/// `tolerance` of the best.
+/// `tolerance` of the best. A NaN value counts as `+∞`, so it never wins (`total_cmp` would
+/// put the negative NaN of x86 arithmetic first).
 pub(crate) fn nelder_mead<const N: usize>(
     mut f: impl FnMut([f64; N]) -> f64,
     step: f64,
     tolerance: f64,
     max_evals: usize,
 ) -> ([f64; N], f64) {
+    let mut f = |x| {
+        let value = f(x);
+        if value.is_nan() { f64::INFINITY } else { value }
+    };
     let mut points: alloc::vec::Vec<([f64; N], f64)> = (0..=N)
         .map(|i| {
             let mut x = [0.0; N];
@@ -130,5 +135,20 @@ mod tests {
             (x[0] - 0.5).abs() < 1e-4 && (x[1] - 0.5).abs() < 1e-4,
             "{x:?}"
         );
+    }
+
+    /// A NaN value, even the negative NaN that `total_cmp` orders first, never wins.
+    #[test]
+    fn the_simplex_never_returns_nan() {
+        let walled = |x: [f64; 2]| {
+            if x[0] + x[1] > 0.5 {
+                f64::NAN.copysign(-1.0)
+            } else {
+                (x[0] - 1.0).powi(2) + (x[1] - 1.0).powi(2)
+            }
+        };
+        let (x, value) = nelder_mead(walled, 0.1, 1e-12, 10_000);
+        assert!(value.is_finite() && value <= 2.0, "{x:?} {value}");
+        assert!(x[0] + x[1] <= 0.5, "{x:?}");
     }
 }
