@@ -67,7 +67,7 @@ struct Edge {
 }
 
 /// Hulls of at most this many vertices are measured by a scan of every vertex, not by
-/// climbs ([`Solid::extent`]): the fast fit's hulls of 26 extremal points.
+/// climbs ([`Solid::extent`]): the hulls of small meshes (a box's 8 corners).
 const SCANNED: usize = 32;
 
 /// Triangles per lane group of [`Solid::shadow`].
@@ -96,8 +96,8 @@ const CELL_MARGIN: f64 = pow2(-30);
 /// sum `m` of its triangles' unit normals to a cell of a grid on the cube's face that `m`
 /// points through (`side × side` cells a face, about [`CELL_EDGES`] edges a cell). Only
 /// the bounds matter for the outline, not which cell an edge went to: an edge with no
-/// direction (a triangle with no area) goes to the first. A hull of few edges (the fast
-/// fit's) gets one cell that is never ruled out.
+/// direction (a triangle with no area) goes to the first. A hull of few edges gets one cell
+/// that is never ruled out.
 fn cells(edges: &mut Vec<Edge>, areas: &[DVec3], bands: &[f64]) -> Vec<Cell> {
     if edges.len() <= 6 * CELL_EDGES {
         return vec![Cell {
@@ -399,8 +399,18 @@ fn coord(p: DVec3) -> Coord3D<f64> {
     }
 }
 
+/// The key that merges the directions of coplanar faces: a unit normal on a grid of
+/// `2^-24`, far coarser than the rounding of normals of faces in one plane, far finer than
+/// the angles between a mesh's distinct faces.
+pub(crate) fn direction_key(unit: DVec3) -> [i64; 3] {
+    (unit * f64::from(1u32 << 24))
+        .round()
+        .as_i64vec3()
+        .to_array()
+}
+
 /// Exact: `d` lies strictly above the plane of the counter-clockwise triangle `a, b, c`.
-fn above(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+pub(crate) fn above(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
     orient3d(coord(a), coord(b), coord(c), coord(d)) < 0.0
 }
 
@@ -430,7 +440,7 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
 /// Four affinely independent points to start from (the first point, the farthest from
 /// it, the farthest from their line, the farthest from their plane), or the hull of a set
 /// that has none.
-fn tetrahedron(points: &[DVec3]) -> Result<[usize; 4], Hull> {
+pub(crate) fn tetrahedron(points: &[DVec3]) -> Result<[usize; 4], Hull> {
     let Some(&p0) = points.first() else {
         return Err(Hull::Point);
     };
@@ -554,14 +564,14 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
 /// neither overflow nor underflow `f64`), far below the pad, `2^-40` times that; beyond the
 /// pad its sign is the exact sign.
 #[derive(Clone, Copy, Debug)]
-struct Plane {
+pub(crate) struct Plane {
     a: DVec3,
     n: DVec3,
     pad: f64,
 }
 
 impl Plane {
-    fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
+    pub(crate) fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
         let (ab, ac) = (b - a, c - a);
         Self {
             a,
@@ -586,7 +596,7 @@ impl Plane {
     /// `Some(true)` when `p` lies strictly above the plane (on the side of `n`),
     /// `Some(false)` strictly below, `None` within the pad (undecided).
     #[inline]
-    fn side(&self, p: DVec3) -> Option<bool> {
+    pub(crate) fn side(&self, p: DVec3) -> Option<bool> {
         let d = p - self.a;
         let height = self.n.dot(d);
         let pad = self.pad * d.abs().element_sum();

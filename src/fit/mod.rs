@@ -20,6 +20,7 @@ mod bound;
 mod capsule;
 mod cloud;
 mod eigen;
+mod extremal;
 mod hull;
 mod obb;
 mod rect;

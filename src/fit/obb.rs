@@ -2,17 +2,19 @@
 
 use super::bound::{Bounded, sum_magnitude};
 use super::cloud::{self, exact};
+use crate::num::pow2;
 use alloc::vec;
 use alloc::vec::Vec;
 
 use super::eigen::principal_axes;
-use super::hull::{Hull, Solid, convex_hull};
-use super::rect::min_area_rectangle;
+use super::extremal::{self, frame_from};
+use super::hull::{Hull, Solid, convex_hull, direction_key};
+use super::rect::rectangle_frame;
 use super::search::compass_search;
 use super::sweep;
 use super::{Fit, FitError};
 use crate::aabb::Aabb3;
-use glam::{DMat3, DQuat, DVec2, DVec3, Mat3A, Vec3, Vec3A};
+use glam::{DMat3, DQuat, DVec3, Mat3A, Vec3, Vec3A};
 
 /// An oriented box: the points `x` with `|(x − center)·axis_k| <= half_extents[k]` for each
 /// column `axis_k` of `rotation`.
@@ -279,11 +281,6 @@ fn widened(h: Vec3A, r: Vec3A) -> Vec3A {
 /// among the candidates that exist; [`FitError::Overflow`] when none does (every box that
 /// is refused overflows: the coordinate axes are always among the candidates).
 fn smallest(boxes: impl IntoIterator<Item = Result<Obb3, FitError>>) -> Result<Obb3, FitError> {
-    // Finite half-extents of `f32`: the keys are finite in `f64`.
-    let key = |b: &Obb3| {
-        let h = b.half_extents.as_dvec3();
-        (h.element_product(), h.x * h.y + h.y * h.z + h.z * h.x)
-    };
     boxes
         .into_iter()
         .filter_map(Result::ok)
@@ -292,6 +289,13 @@ fn smallest(boxes: impl IntoIterator<Item = Result<Obb3, FitError>>) -> Result<O
             ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
         })
         .ok_or(FitError::Overflow)
+}
+
+/// The order of [`smallest`]: the volume key `h0·h1·h2`, then the surface key
+/// `h0·h1 + h1·h2 + h2·h0` (finite in `f64` for the finite half-extents of `f32`).
+fn key(b: &Obb3) -> (f64, f64) {
+    let h = b.half_extents.as_dvec3();
+    (h.element_product(), h.x * h.y + h.y * h.z + h.z * h.x)
 }
 
 /// The PCA baseline: eigenvectors of the covariance of the distinct points, centered on
@@ -304,43 +308,25 @@ fn fit_pca(points: &[Vec3], bounds: &Aabb3) -> Result<Obb3, FitError> {
     obb
 }
 
-/// How many face normals of the extremal points' hull the fast fit bounds: all of them (a
-/// hull of 26 points has at most 48 faces).
-const FAST_NORMALS: usize = 48;
-/// How many of them get their rectangle in the fast fit: those of least bound (see
-/// [`face_frames`]). On the test meshes the best face frame is always among the first 8
-/// (the first 4 miss the teapot's: 1.18× the tight box instead of 1.05×), and the bound
-/// rarely rules out more: a shadow's rectangle exceeds its area by up to `4/π` on round
-/// shapes.
-const FAST_RECTANGLES: usize = 8;
-
 /// The fast fit: the smallest midrange box over the coordinate axes, the PCA axes (of the
 /// points as given) and the best frame of the extremal points along the 13 sample
 /// directions ([`super::sweep::projections`]). Those few points stand in for the points:
-/// DiTO's frames of the first 14 and the face frames of the hull of all 26
-/// ([`face_frames`]) are ranked by the volume they give them, and the best is measured on
+/// DiTO's frames of the first 14 and the face frames of the hull of all 26 are ranked by
+/// the volume they give them ([`extremal::best_frame`]), and the best is measured on
 /// every point.
 fn fit_fast(points: &[Vec3], summary: cloud::Summary) -> Result<Obb3, FitError> {
     let bounds = &summary.bounds;
     let pca = principal_axes(summary.covariance);
     let mut extremal = summary.extremal;
-    let dito = dito_frames(&extremal[..14]);
+    let mut dito = [DVec3::ZERO; 14];
+    dito.copy_from_slice(&extremal[..14]);
     extremal.sort_by(|a, b| {
         a.to_array()
             .partial_cmp(&b.to_array())
             .unwrap_or(core::cmp::Ordering::Equal)
     });
     extremal.dedup();
-    let faces = match convex_hull(&extremal) {
-        Hull::Solid(hull) => face_frames(&hull, FAST_NORMALS, FAST_RECTANGLES, 1),
-        _ => Vec::new(),
-    };
-    let best = dito
-        .into_iter()
-        .map(|f| (volume_over(&f, &extremal), f))
-        .chain(faces)
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map_or(pca, |(_, f)| f);
+    let best = extremal::best_frame(&extremal, &dito).unwrap_or(pca);
     // The coordinate axes' projection range is the bounding box itself, exactly.
     let aabb = certified_box(
         Mat3A::IDENTITY,
@@ -349,78 +335,37 @@ fn fit_fast(points: &[Vec3], summary: cloud::Summary) -> Result<Obb3, FitError> 
         bounds,
         Center::Midrange,
     );
-    let rotations = [to_f32(pca), to_f32(best)];
-    smallest(
-        fit_axes(points, bounds, rotations, Center::Midrange)
-            .into_iter()
-            .chain([aabb]),
-    )
-}
-
-/// The extents `max − min` of the projections of `points` on the columns of `frame`.
-fn extents(frame: &DMat3, points: &[DVec3]) -> DVec3 {
-    let mut lo = DVec3::INFINITY;
-    let mut hi = DVec3::NEG_INFINITY;
-    for &p in points {
-        let q = frame.transpose() * p;
-        lo = lo.min(q);
-        hi = hi.max(q);
-    }
-    (hi - lo).max(DVec3::ZERO)
-}
-
-/// The volume of the box with axes `frame` around `points`.
-fn volume_over(frame: &DMat3, points: &[DVec3]) -> f64 {
-    extents(frame, points).element_product()
-}
-
-/// A right-handed orthonormal frame whose first axis is `axis` and second the part of
-/// `toward` orthogonal to it (any orthogonal direction when that part vanishes).
-fn frame_from(axis: DVec3, toward: DVec3) -> Option<DMat3> {
-    let u = axis.try_normalize()?;
-    let v = (toward - u * u.dot(toward))
-        .try_normalize()
-        .unwrap_or_else(|| u.any_orthonormal_vector());
-    Some(DMat3::from_cols(u, v, u.cross(v)))
-}
-
-/// DiTO's candidate frames (Larsson & Källberg 2011) from the extremal points, taken in
-/// pairs along each sample direction: the base triangle joins the farthest pair to the
-/// point farthest from their line; the points farthest above and below its plane add a
-/// tetrahedron on each side. Each triangle gives one frame per edge: the edge, the
-/// in-plane orthogonal, the normal.
-fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
-    let farthest = |key: &dyn Fn(DVec3) -> f64| {
-        extremal
-            .iter()
-            .copied()
-            .max_by(|&a, &b| key(a).total_cmp(&key(b)))
-            .unwrap_or(DVec3::ZERO)
+    let [best] = fit_axes(points, bounds, [to_f32(best)], Center::Midrange);
+    // The PCA axes are measured on every point only when their box may be the smallest.
+    let pca = to_f32(pca);
+    let pca = match &best {
+        Ok(b) if least_key(pca, &extremal, bounds) > key(b).0 => None,
+        _ => Some(fit_axes(points, bounds, [pca], Center::Midrange)[0]),
     };
-    let Some((p0, p1)) = extremal
-        .chunks_exact(2)
-        .map(|pair| (pair[0], pair[1]))
-        .max_by(|a, b| {
-            a.0.distance_squared(a.1)
-                .total_cmp(&b.0.distance_squared(b.1))
-        })
-    else {
-        return Vec::new();
+    smallest(pca.into_iter().chain([best, aabb]))
+}
+
+/// A lower bound on the volume key `h0·h1·h2` of the certified box with the axes of
+/// `rotation` around any points that include `some` (within `bounds`).
+///
+/// Such a box's half-extents are at least half the exact extents of `some` on its columns.
+/// Each extent is computed from projections within `γ(2)·S` of exact (`S = Σ_j |a_j|·reach_j`,
+/// as in [`fit_axes`]), and their difference rounds once: so the computed extent, less
+/// `2^-52` of itself and less `2^-40·S`, is below the exact one. The product of three
+/// such halves rounds twice more, which the final factor `1 − 2^-40` covers.
+fn least_key(rotation: Mat3A, some: &[DVec3], bounds: &Aabb3) -> f64 {
+    let frame = DMat3::from_cols(
+        rotation.x_axis.as_dvec3(),
+        rotation.y_axis.as_dvec3(),
+        rotation.z_axis.as_dvec3(),
+    );
+    let reach = bounds.min.abs().max(bounds.max.abs()).as_dvec3();
+    let extents = extremal::extents(&frame, some);
+    let half = |k: usize| {
+        let pad = pow2(-40) * frame.col(k).abs().dot(reach);
+        0.5 * (extents[k] * (1.0 - pow2(-52)) - pad).max(0.0)
     };
-    let line = (p1 - p0).normalize_or_zero();
-    let p2 = farthest(&|p| (p - p0).cross(line).length_squared());
-    let normal = (p1 - p0).cross(p2 - p0);
-    let mut triangles = vec![[p0, p1, p2]];
-    for apex in [farthest(&|p| p.dot(normal)), farthest(&|p| -p.dot(normal))] {
-        triangles.extend([[p0, p1, apex], [p1, p2, apex], [p2, p0, apex]]);
-    }
-    triangles
-        .iter()
-        .flat_map(|t| {
-            let n = (t[1] - t[0]).cross(t[2] - t[0]);
-            (0..3).filter_map(move |k| frame_from(t[(k + 1) % 3] - t[k], n))
-        })
-        .collect()
+    half(0) * half(1) * half(2) * (1.0 - pow2(-40))
 }
 
 /// The tight fit's candidate frames and the points that decide them (the hull vertices
@@ -449,9 +394,9 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
     match convex_hull(points) {
         Hull::Point => one(None),
         Hull::Segment(line) => one(frame_from(line, DVec3::ZERO)),
-        Hull::Planar(normal) => one(Some(rectangle_frame(normal, points.iter().copied()))),
+        Hull::Planar(normal) => one(Some(rectangle_frame(normal, points))),
         Hull::Solid(hull) => {
-            let scored = face_frames(&hull, MAX_FACE_NORMALS, MAX_FACE_NORMALS, REFINED);
+            let scored = face_frames(&hull, MAX_FACE_NORMALS, REFINED);
             let frames = scored
                 .iter()
                 .take(REFINED)
@@ -468,8 +413,7 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// The `keep` best frames among the distinct face normals of a hull (the `normals` of
 /// largest area, [`face_normals`]): for each normal, the frame of the minimum-area
 /// rectangle around the hull along it (found from the hull's outline along it,
-/// [`Solid::outline`]), with the volume of its box; smallest first. At most `rectangles`
-/// rectangles are computed, for the normals of least bound (below).
+/// [`Solid::outline`]), with the volume of its box; smallest first.
 ///
 /// Most normals are ruled out without their rectangle. The box along `n` holds the hull,
 /// so its volume is at least the hull's extent along `n` times the area of the hull's
@@ -477,7 +421,7 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// `½·Σ_f |n·A_f|` over its faces' area vectors `A_f` (the projection is covered twice).
 /// Normals are taken in order of that bound, and once it exceeds the `keep`-th best
 /// volume found (with a relative margin of `10^-9` for its rounding), none left can enter.
-fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> Vec<(f64, DMat3)> {
+fn face_frames(hull: &Solid, normals: usize, keep: usize) -> Vec<(f64, DMat3)> {
     let vertices = &hull.vertices;
     // Each normal's ends start the climbs of the next.
     let mut ends = [0; 2];
@@ -489,12 +433,12 @@ fn face_frames(hull: &Solid, normals: usize, rectangles: usize, keep: usize) -> 
     let mut best: Vec<(f64, DMat3)> = Vec::with_capacity(keep + 1);
     // Each box's extremes start the climbs of the next.
     let mut from = [0; 6];
-    for (bound, n) in bounded.into_iter().take(rectangles) {
+    for (bound, n) in bounded {
         if best.len() == keep && best.last().is_some_and(|b| bound > b.0 * (1.0 + 1e-9)) {
             break;
         }
-        let outline = hull.outline(n).into_iter().map(|i| vertices[i]);
-        let frame = rectangle_frame(n, outline);
+        let outline: Vec<DVec3> = hull.outline(n).into_iter().map(|i| vertices[i]).collect();
+        let frame = rectangle_frame(n, &outline);
         let volume = hull.extents(&frame, &mut from).element_product();
         let at = best.partition_point(|b| b.0 <= volume);
         best.insert(at, (volume, frame));
@@ -519,10 +463,7 @@ fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
         let Some(unit) = area.try_normalize() else {
             continue;
         };
-        let key = (unit * f64::from(1u32 << 24))
-            .round()
-            .as_i64vec3()
-            .to_array();
+        let key = direction_key(unit);
         let hash = key.iter().fold(0u64, |h, &k| {
             (h ^ k as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         });
@@ -555,16 +496,6 @@ fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
         .into_iter()
         .map(|(_, _, t)| areas[t].normalize())
         .collect()
-}
-
-/// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
-/// points projected on the plane orthogonal to the unit `normal`.
-fn rectangle_frame(normal: DVec3, points: impl Iterator<Item = DVec3>) -> DMat3 {
-    let (e1, e2) = normal.any_orthonormal_pair();
-    let mut flat: Vec<DVec2> = points.map(|p| DVec2::new(p.dot(e1), p.dot(e2))).collect();
-    let (side, _) = min_area_rectangle(&mut flat);
-    let u = e1 * side.x + e2 * side.y;
-    DMat3::from_cols(u, normal.cross(u), normal)
 }
 
 /// A local minimum of the volume over rotations `frame·exp(ω)` near `frame`, each volume

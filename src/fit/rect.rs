@@ -8,7 +8,7 @@
 //! their extents again from every point.
 
 use alloc::vec::Vec;
-use glam::DVec2;
+use glam::{DMat3, DVec2, DVec3};
 
 /// The convex hull, counter-clockwise, without collinear vertices (any order of input),
 /// sorting the points in place.
@@ -44,11 +44,60 @@ pub(crate) fn convex_hull_2d(points: &mut [DVec2]) -> Vec<DVec2> {
     hull
 }
 
+/// Point sets of at most this many points are wrapped ([`wrapped_hull`]), not sorted.
+const FEW: usize = 32;
+
+/// The convex hull of at most [`FEW`] points, counter-clockwise from the least point in
+/// `(x, y)` order, without collinear vertices, by gift wrapping (Jarvis 1973): `O(n·h)`
+/// for `h` vertices, with no sort and no allocation, which costs less than the monotone
+/// chain on a few points. Each step takes the point that no other lies to the right of
+/// (the farthest of those on its line). Rounding near collinear points could keep the
+/// wrap from closing: it stops after as many vertices as points.
+fn wrapped_hull(points: &[DVec2], hull: &mut [DVec2; FEW]) -> usize {
+    let Some(start) = points
+        .iter()
+        .copied()
+        .min_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)))
+    else {
+        return 0;
+    };
+    let (mut at, mut m) = (start, 0);
+    while m < points.len().min(FEW) {
+        hull[m] = at;
+        m += 1;
+        let mut next = at;
+        for &p in points {
+            let turn = (next - at).perp_dot(p - at);
+            let farther = || (p - at).length_squared() > (next - at).length_squared();
+            if next == at || turn < 0.0 || (turn == 0.0 && farther()) {
+                next = p;
+            }
+        }
+        if next == start || next == at {
+            break;
+        }
+        at = next;
+    }
+    m
+}
+
 /// The unit direction of one side of the minimum-area rectangle around `points`, and the
 /// rectangle's area. For fewer than three hull vertices: the direction of the segment
 /// (or `x`) and area 0.
 pub(crate) fn min_area_rectangle(points: &mut [DVec2]) -> (DVec2, f64) {
-    let hull = convex_hull_2d(points);
+    if points.len() <= FEW {
+        let mut hull = [DVec2::ZERO; FEW];
+        let m = wrapped_hull(points, &mut hull);
+        return calipers(&hull[..m]);
+    }
+    calipers(&convex_hull_2d(points))
+}
+
+/// [`min_area_rectangle`] of the convex polygon `hull` (counter-clockwise, no collinear
+/// vertices), by rotating calipers. An edge `e` is not normalised: its rectangle's sides
+/// are the ranges of `q·e` and `q·e⊥` over the vertices, and its area their product over
+/// `|e|²`.
+fn calipers(hull: &[DVec2]) -> (DVec2, f64) {
     let m = hull.len();
     if m < 3 {
         let along = match hull[..] {
@@ -57,33 +106,50 @@ pub(crate) fn min_area_rectangle(points: &mut [DVec2]) -> (DVec2, f64) {
         };
         return (along, 0.0);
     }
-    let at = |i: usize| hull[i % m];
+    // Indices run over two laps: `at(i)` for `i < 2m`.
+    let at = |i: usize| hull[if i < m { i } else { i - m }];
     // Advance `i` while the next vertex lies farther along `dir` (at most one lap).
     let advance = |mut i: usize, dir: DVec2| {
-        for _ in 0..m {
-            if (at(i + 1) - at(i)).dot(dir) > 0.0 {
-                i += 1;
-            } else {
-                break;
-            }
+        let end = (i + m).min(2 * m - 1);
+        while i < end && (at(i + 1) - at(i)).dot(dir) > 0.0 {
+            i += 1;
         }
         i
     };
     let (mut right, mut top, mut left) = (0, 0, 0);
     let mut best = (DVec2::X, f64::INFINITY);
     for i in 0..m {
-        let u = (at(i + 1) - at(i)).normalize_or(DVec2::X);
+        let u = at(i + 1) - at(i);
         let v = u.perp();
         right = advance(right.max(i), u);
         top = advance(top.max(right), v);
         left = advance(left.max(top), -u);
         let width = (at(right) - at(left)).dot(u);
         let height = (at(top) - at(i)).dot(v);
-        if width * height < best.1 {
-            best = (u, width * height);
+        let area = width * height / u.length_squared();
+        if area < best.1 {
+            best = (u, area);
         }
     }
-    best
+    (best.0.normalize_or(DVec2::X), best.1)
+}
+
+/// The frame `(u, n × u, n)` where `u` is a side of the minimum-area rectangle of the
+/// points projected on the plane orthogonal to the unit `normal`.
+pub(crate) fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
+    let (e1, e2) = normal.any_orthonormal_pair();
+    let flat = |p: &DVec3| DVec2::new(p.dot(e1), p.dot(e2));
+    let (side, _) = if points.len() <= FEW {
+        let mut few = [DVec2::ZERO; FEW];
+        for (q, p) in few.iter_mut().zip(points) {
+            *q = flat(p);
+        }
+        min_area_rectangle(&mut few[..points.len()])
+    } else {
+        min_area_rectangle(&mut points.iter().map(flat).collect::<Vec<_>>())
+    };
+    let u = e1 * side.x + e2 * side.y;
+    DMat3::from_cols(u, normal.cross(u), normal)
 }
 
 #[cfg(test)]

@@ -1,0 +1,443 @@
+//! The fast fit's choice of axes from its few extremal points (at most [`POINTS`]): DiTO's
+//! frames and the face frames of the points' hull, ranked by the volume they give them.
+//!
+//! **The hull of a few points.** A hull of at most [`POINTS`] vertices has at most
+//! [`FACES`] triangles, so it is built here by incremental insertion into fixed arrays: no
+//! allocation, and none of the edges, cells and climbs that [`hull::convex_hull`] builds
+//! for the tight fit's large hulls. The side tests are the same exact predicate
+//! ([`hull::above`]) behind the same floating-point filter ([`hull::Plane`]), so the
+//! triangles are exactly those of a convex polytope:
+//! - a triangle sees a point only when the point lies strictly above its plane, so a point
+//!   in or on the hull is dropped;
+//! - the triangles that see a point outside form a disk bounded by one simple cycle of
+//!   horizon edges, each run by a seen triangle and, the other way, by an unseen one;
+//! - each horizon edge `u → v` gets the triangle `(u, v, p)`, which has area: `p` lies
+//!   strictly above the seen triangle's plane, which holds `u` and `v`.
+//!
+//! A closed surface of triangles on `V` vertices has `2V − 4` of them, so the arrays never
+//! fill; were they to, the hull would give no frame rather than a wrong one. Either way the
+//! box is measured afterwards on every input point: the frames only choose its axes.
+
+use super::hull::{self, Plane};
+use super::rect::rectangle_frame;
+use super::sweep;
+use crate::num::pow2;
+use alloc::vec;
+use alloc::vec::Vec;
+use glam::{DMat3, DVec3};
+
+/// At most this many points: the extremes on each sample direction of the summary.
+pub(crate) const POINTS: usize = 2 * sweep::DIRECTIONS;
+
+/// At most this many triangles on a hull of [`POINTS`] vertices (`2V − 4`).
+const FACES: usize = 2 * POINTS - 4;
+
+/// How many face normals get their rectangle: those of least bound (see [`face_frame`]).
+/// On the test meshes the best face frame is always among the first 8 (the first 4 miss
+/// the teapot's: 1.18× the tight box instead of 1.05×), and the bound rarely rules out
+/// more: a shadow's rectangle exceeds its area by up to `4/π` on round shapes.
+const RECTANGLES: usize = 8;
+
+/// The frame of least volume over `points` (distinct, at most [`POINTS`], the first 14
+/// paired along DiTO's 7 directions) among DiTO's frames of the first 14 and the face
+/// frames of the hull of all ([`face_frame`]); `None` when there is none (fewer than
+/// three points, or all on a line).
+pub(crate) fn best_frame(points: &[DVec3], dito: &[DVec3]) -> Option<DMat3> {
+    let best = dito_frames(dito)
+        .into_iter()
+        .map(|f| (volume_over(&f, points), f))
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    face_frame(points, best).map(|(_, f)| f)
+}
+
+/// The extents `max − min` of the projections of `points` on the columns of `frame`.
+pub(crate) fn extents(frame: &DMat3, points: &[DVec3]) -> DVec3 {
+    let mut lo = DVec3::INFINITY;
+    let mut hi = DVec3::NEG_INFINITY;
+    for &p in points {
+        let q = frame.transpose() * p;
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    (hi - lo).max(DVec3::ZERO)
+}
+
+/// The volume of the box with axes `frame` around `points`.
+pub(crate) fn volume_over(frame: &DMat3, points: &[DVec3]) -> f64 {
+    extents(frame, points).element_product()
+}
+
+/// A right-handed orthonormal frame whose first axis is `axis` and second the part of
+/// `toward` orthogonal to it (any orthogonal direction when that part vanishes).
+pub(crate) fn frame_from(axis: DVec3, toward: DVec3) -> Option<DMat3> {
+    let u = axis.try_normalize()?;
+    let v = (toward - u * u.dot(toward))
+        .try_normalize()
+        .unwrap_or_else(|| u.any_orthonormal_vector());
+    Some(DMat3::from_cols(u, v, u.cross(v)))
+}
+
+/// DiTO's candidate frames (Larsson & Källberg 2011) from the extremal points, taken in
+/// pairs along each sample direction: the base triangle joins the farthest pair to the
+/// point farthest from their line; the points farthest above and below its plane add a
+/// tetrahedron on each side. Each triangle gives one frame per edge: the edge, the
+/// in-plane orthogonal, the normal.
+fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
+    let farthest = |key: &dyn Fn(DVec3) -> f64| {
+        extremal
+            .iter()
+            .copied()
+            .max_by(|&a, &b| key(a).total_cmp(&key(b)))
+            .unwrap_or(DVec3::ZERO)
+    };
+    let Some((p0, p1)) = extremal
+        .chunks_exact(2)
+        .map(|pair| (pair[0], pair[1]))
+        .max_by(|a, b| {
+            a.0.distance_squared(a.1)
+                .total_cmp(&b.0.distance_squared(b.1))
+        })
+    else {
+        return Vec::new();
+    };
+    let line = (p1 - p0).normalize_or_zero();
+    let p2 = farthest(&|p| (p - p0).cross(line).length_squared());
+    let normal = (p1 - p0).cross(p2 - p0);
+    let mut triangles = vec![[p0, p1, p2]];
+    for apex in [farthest(&|p| p.dot(normal)), farthest(&|p| -p.dot(normal))] {
+        triangles.extend([[p0, p1, apex], [p1, p2, apex], [p2, p0, apex]]);
+    }
+    triangles
+        .iter()
+        .flat_map(|t| {
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            (0..3).filter_map(move |k| frame_from(t[(k + 1) % 3] - t[k], n))
+        })
+        .collect()
+}
+
+/// The triangles of the hull of `points` (distinct, at most [`POINTS`]), outward
+/// (counter-clockwise seen from outside), as indices into `points`, and how many there
+/// are; `None` for points that span no solid, or arrays that would overflow (see the
+/// module doc).
+fn triangles(points: &[DVec3]) -> Option<([[u8; 3]; FACES], usize)> {
+    if points.len() > POINTS {
+        return None;
+    }
+    let [a, b, c, d] = hull::tetrahedron(points).ok()?.map(|i| i as u8);
+    let at = |i: u8| points[usize::from(i)];
+    let (b, c) = if hull::above(at(a), at(b), at(c), at(d)) {
+        (c, b)
+    } else {
+        (b, c)
+    };
+    let plane = |f: [u8; 3]| {
+        let [u, v, w] = f.map(at);
+        Plane::new(u, v, w)
+    };
+    let mut faces = [[0u8; 3]; FACES];
+    faces[..4].copy_from_slice(&[[a, b, c], [b, a, d], [c, b, d], [a, c, d]]);
+    let mut planes = [plane(faces[0]); FACES];
+    for f in 1..4 {
+        planes[f] = plane(faces[f]);
+    }
+    let mut len = 4;
+    let mut horizon = [[0u8; 2]; 3 * FACES];
+    for (i, &p) in points.iter().enumerate() {
+        if [a, b, c, d].contains(&(i as u8)) {
+            continue;
+        }
+        let sees = |f: usize| {
+            planes[f].side(p).unwrap_or_else(|| {
+                let [u, v, w] = faces[f].map(at);
+                hull::above(u, v, w, p)
+            })
+        };
+        let mut seen = [false; FACES];
+        let mut list = [0usize; FACES];
+        let mut count = 0;
+        for (f, seen) in seen.iter_mut().enumerate().take(len) {
+            if sees(f) {
+                (*seen, list[count]) = (true, f);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            continue;
+        }
+        // A seen triangle's edge is on the horizon when no seen triangle runs it backwards.
+        let mut edges = 0;
+        for &f in &list[..count] {
+            for k in 0..3 {
+                let (u, v) = (faces[f][k], faces[f][(k + 1) % 3]);
+                let runs_back =
+                    |g: &usize| (0..3).any(|j| faces[*g][j] == v && faces[*g][(j + 1) % 3] == u);
+                if !list[..count].iter().any(runs_back) {
+                    horizon[edges] = [u, v];
+                    edges += 1;
+                }
+            }
+        }
+        let mut kept = 0;
+        for f in 0..len {
+            if !seen[f] {
+                (faces[kept], planes[kept]) = (faces[f], planes[f]);
+                kept += 1;
+            }
+        }
+        if kept + edges > FACES {
+            return None;
+        }
+        for (k, &[u, v]) in horizon[..edges].iter().enumerate() {
+            faces[kept + k] = [u, v, i as u8];
+            planes[kept + k] = plane(faces[kept + k]);
+        }
+        len = kept + edges;
+    }
+    Some((faces, len))
+}
+
+/// The best face frame of the hull of `points` (distinct, at most [`POINTS`]), with its
+/// volume over them, or `best` when none beats it.
+///
+/// Each direction of the hull's triangles (coplanar ones merged) is a candidate normal `n`,
+/// whose frame is that of the minimum-area rectangle of the points projected along `n`.
+/// A box with axis `n` holds the hull, so its volume is at least the hull's extent along
+/// `n` times the area of the hull's shadow on the plane orthogonal to `n`,
+/// `¼·Σ_t |n·A_t|` over the triangles' doubled area vectors `A_t` (the shadow is covered
+/// twice). The first [`RECTANGLES`] normals in order of that bound get their rectangle,
+/// until the bound exceeds the best volume (with a relative margin of `10^-9` for its
+/// rounding), when no normal left can beat it.
+fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat3)> {
+    let Some((faces, len)) = triangles(points) else {
+        return best;
+    };
+    let at = |i: u8| points[usize::from(i)];
+    // The triangles' doubled area vectors, as columns padded with zero vectors, and the
+    // points as columns padded with the first point.
+    let mut area = [[0.0; FACES]; 3];
+    let mut normals = [(0.0, [0i64; 3], DVec3::ZERO); FACES];
+    let mut count = 0;
+    for (t, f) in faces[..len].iter().enumerate() {
+        let [u, v, w] = f.map(at);
+        let a = (v - u).cross(w - u);
+        for (column, value) in area.iter_mut().zip(a.to_array()) {
+            column[t] = value;
+        }
+        let Some(unit) = a.try_normalize() else {
+            continue;
+        };
+        let key = hull::direction_key(unit);
+        normals[count] = (0.0, key, unit);
+        count += 1;
+    }
+    // Coplanar triangles share a key: one normal each (any of theirs: they differ by
+    // rounding).
+    let normals = &mut normals[..count];
+    normals.sort_unstable_by_key(|normal| normal.1);
+    let mut distinct = 0;
+    for i in 0..normals.len() {
+        if i == 0 || normals[i].1 != normals[distinct - 1].1 {
+            normals[distinct] = normals[i];
+            distinct += 1;
+        }
+    }
+    let normals = &mut normals[..distinct];
+    // The hull's vertices, as points and as columns padded with the first.
+    let mut vertex = [false; POINTS];
+    for &i in faces[..len].iter().flatten() {
+        vertex[usize::from(i)] = true;
+    }
+    let mut corners = [DVec3::ZERO; POINTS];
+    let mut m = 0;
+    for (p, _) in points.iter().zip(vertex).filter(|(_, v)| *v) {
+        corners[m] = *p;
+        m += 1;
+    }
+    let corners = &corners[..m];
+    let mut column = [
+        [corners[0].x; COLUMN],
+        [corners[0].y; COLUMN],
+        [corners[0].z; COLUMN],
+    ];
+    for (j, p) in corners.iter().enumerate() {
+        (column[0][j], column[1][j], column[2][j]) = (p.x, p.y, p.z);
+    }
+    // Which triangle runs each edge `u → v`.
+    let mut runs = [[NO_FACE; POINTS]; POINTS];
+    for (t, f) in faces[..len].iter().enumerate() {
+        for k in 0..3 {
+            runs[usize::from(f[k])][usize::from(f[(k + 1) % 3])] = t as u8;
+        }
+    }
+    crate::simd::plain(
+        #[inline(always)]
+        || {
+            for (bound, _, n) in normals.iter_mut() {
+                *bound = extent(&column, *n) * shadow(&area, *n);
+            }
+        },
+    );
+    normals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut best = best;
+    for &(bound, _, n) in normals.iter().take(RECTANGLES) {
+        if best.is_some_and(|(volume, _)| bound > volume * (1.0 + 1e-9)) {
+            break;
+        }
+        let on = outline(&faces[..len], &runs, &area, n);
+        let mut shadow = [DVec3::ZERO; POINTS];
+        let mut k = 0;
+        for (p, _) in points.iter().zip(on).filter(|(_, on)| *on) {
+            shadow[k] = *p;
+            k += 1;
+        }
+        let frame = rectangle_frame(n, &shadow[..k]);
+        let volume = volume_over(&frame, corners);
+        if best.is_none_or(|(least, _)| volume < least) {
+            best = Some((volume, frame));
+        }
+    }
+    best
+}
+
+/// No triangle: an empty entry of the table of edges.
+const NO_FACE: u8 = u8::MAX;
+
+/// The hull's vertices on its outline seen along the unit direction `n`, as a mask over the
+/// points: among them, every vertex whose projection on the plane orthogonal to `n` is a
+/// corner of the hull's shadow there, as for [`hull::Solid::outline`], whose proof this
+/// follows. `runs[u][v]` is the triangle that runs the edge `u → v`.
+///
+/// A triangle faces `n` when `n·A > 2^-40·|A|₁` for its doubled area vector `A` (the `f64`
+/// value of `n·A` is within a few `u = 2^-53` of `|A|₁`, so a triangle that faces `n`
+/// really does), and is edge-on when `|n·A|` is at most that. The outline holds the first
+/// vertex of each edge that leaves a triangle facing `n` for one that does not (these
+/// edges bound the triangles facing `n`, so they form closed cycles, and each of their
+/// vertices starts one), and every vertex of an edge-on triangle.
+fn outline(
+    faces: &[[u8; 3]],
+    runs: &[[u8; POINTS]; POINTS],
+    area: &[[f64; FACES]; 3],
+    n: DVec3,
+) -> [bool; POINTS] {
+    // 1 facing `n`, 0 edge-on, -1 facing away.
+    let mut sides = [0i8; FACES];
+    for (t, side) in sides.iter_mut().enumerate().take(faces.len()) {
+        let a = DVec3::new(area[0][t], area[1][t], area[2][t]);
+        let (h, band) = (a.dot(n), pow2(-40) * a.abs().element_sum());
+        *side = i8::from(h > band) - i8::from(h < -band);
+    }
+    let mut on = [false; POINTS];
+    for (f, side) in faces.iter().zip(sides) {
+        for k in 0..3 {
+            let (u, v) = (usize::from(f[k]), usize::from(f[(k + 1) % 3]));
+            let across = sides.get(usize::from(runs[v][u])).copied();
+            on[u] |= side == 0 || (side == 1 && across != Some(1));
+        }
+    }
+    on
+}
+
+/// Partial sums and extremes per lane group of [`extent`] and [`shadow`].
+const LANES: usize = 4;
+
+/// [`POINTS`] rounded up to whole lane groups.
+const COLUMN: usize = POINTS.next_multiple_of(LANES);
+
+/// The extent `max − min` of the points (as columns, padded with one of them) along `n`.
+#[inline(always)]
+fn extent(column: &[[f64; COLUMN]; 3], n: DVec3) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
+    for g in (0..COLUMN).step_by(LANES) {
+        for j in 0..LANES {
+            let h = column[0][g + j] * n.x + column[1][g + j] * n.y + column[2][g + j] * n.z;
+            lo[j] = if h < lo[j] { h } else { lo[j] };
+            hi[j] = if h > hi[j] { h } else { hi[j] };
+        }
+    }
+    let lo = lo.into_iter().fold(f64::INFINITY, f64::min);
+    let hi = hi.into_iter().fold(f64::NEG_INFINITY, f64::max);
+    (hi - lo).max(0.0)
+}
+
+/// The area of the hull's shadow on the plane orthogonal to the unit `n`, `¼·Σ_t |n·A_t|`
+/// over the doubled area vectors (as columns, padded with zero vectors).
+#[inline(always)]
+fn shadow(area: &[[f64; FACES]; 3], n: DVec3) -> f64 {
+    let mut sums = [0.0; LANES];
+    for g in (0..FACES).step_by(LANES) {
+        for (j, sum) in sums.iter_mut().enumerate() {
+            let t = g + j;
+            *sum += (area[0][t] * n.x + area[1][t] * n.y + area[2][t] * n.z).abs();
+        }
+    }
+    sums.iter().sum::<f64>() / 4.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points in general position, some inside the hull of the others.
+    fn cloud(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64;
+                let r = if i % 4 == 3 { 0.5 } else { 1.0 };
+                DVec3::new((t * 2.4).cos(), (t * 1.7).sin(), (t * 0.9).cos() * 0.7) * r
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_triangles_bound_every_point_and_close_up() {
+        for n in 4..=POINTS {
+            let points = cloud(n);
+            let (faces, len) = triangles(&points).expect("a solid");
+            assert!(len <= FACES);
+            for f in &faces[..len] {
+                let [u, v, w] = f.map(|i| points[usize::from(i)]);
+                // Every point lies on or below every triangle's plane (exactly).
+                assert!(points.iter().all(|&p| !hull::above(u, v, w, p)));
+                // Every edge is run once each way: a closed, consistently oriented surface.
+                for k in 0..3 {
+                    let (a, b) = (f[k], f[(k + 1) % 3]);
+                    let twins = faces[..len]
+                        .iter()
+                        .filter(|g| (0..3).any(|j| g[j] == b && g[(j + 1) % 3] == a))
+                        .count();
+                    assert_eq!(twins, 1, "n = {n}");
+                }
+            }
+            // Euler: a closed surface of triangles on V vertices has 2V − 4 of them.
+            let mut vertices: Vec<u8> = faces[..len].iter().flatten().copied().collect();
+            vertices.sort_unstable();
+            vertices.dedup();
+            assert_eq!(len, 2 * vertices.len() - 4);
+        }
+    }
+
+    #[test]
+    fn the_cube_with_face_points_has_its_corners_for_vertices() {
+        let mut points: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+            .collect();
+        points.extend([DVec3::new(0.5, 0.5, 0.0), DVec3::new(0.5, 0.5, 0.5)]);
+        let (faces, len) = triangles(&points).expect("a solid");
+        assert_eq!(len, 12);
+        assert!(faces[..len].iter().flatten().all(|&i| i < 8));
+        // The cube's face frame is the cube's box.
+        let (volume, _) = face_frame(&points, None).expect("a frame");
+        assert!((volume - 1.0).abs() < 1e-12, "{volume}");
+    }
+
+    #[test]
+    fn flat_and_too_many_points_give_no_hull() {
+        let flat: Vec<DVec3> = (0..6)
+            .map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0))
+            .collect();
+        assert!(triangles(&flat).is_none());
+        assert!(triangles(&cloud(POINTS + 1)).is_none());
+        assert!(face_frame(&flat, None).is_none());
+    }
+}
