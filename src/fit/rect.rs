@@ -156,6 +156,33 @@ pub(crate) fn rectangle_frame(normal: DVec3, points: &[DVec3]) -> DMat3 {
 mod tests {
     use super::*;
 
+    /// On small-integer points (exact arithmetic, with many collinear and repeated points)
+    /// the wrap gives the monotone chain's polygon, vertex for vertex, and so the same
+    /// rectangle.
+    #[test]
+    fn the_wrap_is_the_monotone_chain_on_few_points() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n) as f64
+        };
+        for trial in 0..2000 {
+            let len = 1 + trial % FEW;
+            let side = [3, 5, 9, 100][trial % 4];
+            let mut points: Vec<DVec2> = (0..len)
+                .map(|_| DVec2::new(next(side), next(side)))
+                .collect();
+            let mut wrapped = [DVec2::ZERO; FEW];
+            let m = wrapped_hull(&points, &mut wrapped);
+            let (wrap_side, wrap_area) = calipers(&wrapped[..m]);
+            let chain = convex_hull_2d(&mut points);
+            assert_eq!(&wrapped[..m], &chain[..], "trial {trial}");
+            assert_eq!(calipers(&chain), (wrap_side, wrap_area));
+        }
+    }
+
     #[test]
     fn rotated_rectangle_and_square() {
         let r = DVec2::from_angle(0.3);
