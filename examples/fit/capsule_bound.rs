@@ -182,20 +182,26 @@ struct Square {
     refined: bool,
 }
 
-impl Eq for Square {}
+/// Orders a heap entry with a `bound` field so that a max-heap pops the least bound first.
+macro_rules! least_bound_first {
+    ($entry:ty) => {
+        impl Eq for $entry {}
 
-impl Ord for Square {
-    /// The least bound first, in a max-heap.
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        other.bound.total_cmp(&self.bound)
-    }
+        impl Ord for $entry {
+            fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+                other.bound.total_cmp(&self.bound)
+            }
+        }
+
+        impl PartialOrd for $entry {
+            fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+                Some(self.cmp(other))
+            }
+        }
+    };
 }
 
-impl PartialOrd for Square {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
+least_bound_first!(Square);
 
 /// How many directions pick the points of a large hull (see the module's doc).
 const DIRECTIONS: usize = 1024;
@@ -325,20 +331,7 @@ struct Node {
     b: f64,
 }
 
-impl Eq for Node {}
-
-impl Ord for Node {
-    /// The least bound first, in a max-heap.
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        other.bound.total_cmp(&self.bound)
-    }
-}
-
-impl PartialOrd for Node {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
+least_bound_first!(Node);
 
 /// The nodes' bound of a view: the least volume of a capsule along its square's
 /// directions, from a branch and bound over axis crossings and radii from `r_lo`; and how
