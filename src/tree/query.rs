@@ -4,11 +4,11 @@
 use alloc::vec::Vec;
 use core::ops::ControlFlow;
 
-use glam::{BVec3A, DVec3, Vec3A, Vec4};
+use glam::{DVec3, Vec3A};
 
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Child, Layout, Ref, Store};
-use super::relative::{Lanes, QueryError, Relative};
+use super::relative::{Axes, Lanes, QueryError, Relative};
 use super::triangle::{LANES, TriangleLanes, filter, triangles_distance_sq, triangles_intersect};
 use crate::transform::{Rigid3, Similarity3};
 
@@ -161,9 +161,9 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     /// `batch`, in descent order, in batches of at least `flush_at` pairs (the last one
     /// excepted) and at most [`LANES`], until it breaks.
     ///
-    /// A step pops a pair and tests the boxes below one side's node (up to four, see
-    /// `Below`) against the other side's box; the pairs that pass go on the stack, and
-    /// pairs of primitives leave it for the batch. The triangle tests then run on a whole
+    /// A step pops a pair and splits both nodes (a primitive stays itself): the pairs of a
+    /// child of each, up to four, are tested at once in lanes (`Crosswise`); the pairs
+    /// that pass go on the stack, and pairs of primitives leave it for the batch. The triangle tests then run on a whole
     /// batch at once (a lane filter first).
     ///
     /// `batch` is called through a reference to a trait object, once per batch: the
@@ -208,14 +208,13 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             stats.leaf_pairs += 1;
             return (batch(&[(ha.root.index(), hb.root.index())]), stats);
         }
+        let cross = rel.crosswise();
+        let cross_near_leaves = self.cross_near_leaves;
         // Each pair on the stack passed its box test; the stack's top is the next pair in
         // descent order, leaves included, so pairs of primitives leave in that order.
         let mut stack = Pending::default();
         stack.reserve(1);
-        let split_a = !ha.root.is_primitive()
-            && (hb.root.is_primitive() || ea.element_sum() >= eb.element_sum());
-        let carried = if split_a { (cb, eb) } else { (ca, ea) };
-        stack.put((ha.root, hb.root, Kind::of(false, split_a)), carried, true);
+        stack.put((ha.root, hb.root), [ca, ea, cb, eb], true);
         let mut leaves = [(0u32, 0u32); LANES];
         let mut found = 0;
         let flush_at = flush_at.clamp(1, LANES);
@@ -236,53 +235,87 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             let Some(i) = stack.inner_on_top() else {
                 break;
             };
-            let ((ra, rb, kind), (cf, ef)) = (stack.pairs[i], stack.boxes[i]);
-            // The boxes below the split node, in lanes, against the other side's box: four
-            // tests at once, each kept by a count, not a branch.
+            let ((ra, rb), [ca, ea, cb, eb]) = (stack.pairs[i], stack.boxes[i]);
             stack.reserve(4);
-            let fixed = Lanes::splat(cf, ef);
-            let fixed_sum = Vec4::splat(ef.x + ef.y + ef.z);
-            // The boxes below the split node are `A`'s when it splits `A`, and the fixed box
-            // `B`'s. What each new pair does next: split the side with the larger extent
-            // (summed), never a primitive; two primitives are a leaf.
-            let split_a = kind == Kind::SplitA;
-            let (below, apart, leaf_lanes, split_next_a);
-            if split_a {
-                below = Below::new(la, ra.index(), prim_a);
-                apart = rel.apart_lanes(&rel.on_a_lanes(&fixed), &below.lanes)
-                    | rel.apart_lanes(&rel.on_b_lanes(&below.lanes), &fixed);
-                let (kid_prim, fixed_prim) = (below.primitives(), all_or_none(rb.is_primitive()));
-                let larger = below.extent_sums().cmpge(fixed_sum).bitmask();
-                leaf_lanes = kid_prim & fixed_prim;
-                split_next_a = !kid_prim & (fixed_prim | larger);
-            } else {
-                below = Below::new(lb, rb.index(), prim_b);
-                apart = rel.apart_lanes(&rel.on_a_lanes(&below.lanes), &fixed)
-                    | rel.apart_lanes(&rel.on_b_lanes(&fixed), &below.lanes);
-                let (kid_prim, fixed_prim) = (below.primitives(), all_or_none(ra.is_primitive()));
-                let larger = below.extent_sums().cmpgt(fixed_sum).bitmask();
-                leaf_lanes = kid_prim & fixed_prim;
-                split_next_a = !fixed_prim & (kid_prim | !larger);
-            }
-            stats.node_pairs += u64::from(below.valid.count_ones());
-            for (l, kid) in below.kids.iter().enumerate().rev() {
-                let (a, ca, ea, b, cb, eb) = if split_a {
-                    (kid.r, kid.center, kid.extent, rb, cf, ef)
+            if ra.is_primitive() || rb.is_primitive() {
+                // One side is a primitive: up to four boxes below the other side's node
+                // (`Below`), placed on the primitive's tree's axes, against its box.
+                let (below, axes) = if ra.is_primitive() {
+                    (Below::new(lb, rb.index(), prim_b), Axes::OfA)
                 } else {
-                    (ra, cf, ef, kid.r, kid.center, kid.extent)
+                    (Below::new(la, ra.index(), prim_a), Axes::OfB)
                 };
-                let mut keep = (below.valid & !apart) >> l & 1 != 0;
-                let leaf = leaf_lanes >> l & 1 != 0;
-                if self.cross_near_leaves && keep && leaf {
-                    keep = !rel.roots_separated(ca, ea, cb, eb, margin);
+                let x_placed = cross.place_on(axes, &below.lanes);
+                let apart = if axes == Axes::OfA {
+                    cross.apart_from(&below.lanes, &x_placed, (ca, ea), &rel.on_b(ca, ea))
+                } else {
+                    cross.apart_from(&below.lanes, &x_placed, (cb, eb), &rel.on_a(cb, eb))
+                };
+                stats.node_pairs += u64::from(below.valid.count_ones());
+                let mut keep = below.valid & !apart;
+                if cross_near_leaves {
+                    for (l, kid) in below.kids.iter().enumerate() {
+                        let (a, b) = if axes == Axes::OfA {
+                            ((ca, ea), (kid.center, kid.extent))
+                        } else {
+                            ((kid.center, kid.extent), (cb, eb))
+                        };
+                        if kid.r.is_primitive() && rel.roots_separated(a.0, a.1, b.0, b.1, margin) {
+                            keep &= !(1 << l);
+                        }
+                    }
                 }
-                // Splitting `A` next carries `B`'s box, and splitting `B` carries `A`'s.
-                let split = split_next_a >> l & 1 != 0;
-                let carried = (
-                    Vec3A::select(BVec3A::splat(split), cb, ca),
-                    Vec3A::select(BVec3A::splat(split), eb, ea),
+                for (l, kid) in below.kids.iter().enumerate().rev() {
+                    let entry = if axes == Axes::OfA {
+                        ((ra, kid.r), [ca, ea, kid.center, kid.extent])
+                    } else {
+                        ((kid.r, rb), [kid.center, kid.extent, cb, eb])
+                    };
+                    stack.put(entry.0, entry.1, keep >> l & 1 != 0);
+                }
+                continue;
+            }
+            // Both nodes split: two children of `A` in lanes 0 and 1, two of `B` in lanes 2
+            // and 3, each placed on the other tree's axes, and the four pairs of a child of
+            // each tested at once, each kept by a count.
+            let kids_a = la.children_boxes(ra.index(), prim_a);
+            let kids_b = lb.children_boxes(rb.index(), prim_b);
+            let x = Lanes::new(
+                [
+                    kids_a[0].center,
+                    kids_a[1].center,
+                    kids_b[0].center,
+                    kids_b[1].center,
+                ],
+                [
+                    kids_a[0].extent,
+                    kids_a[1].extent,
+                    kids_b[0].extent,
+                    kids_b[1].extent,
+                ],
+            );
+            let apart = cross.apart_pairs(&x, &cross.place(&x));
+            stats.node_pairs += 4;
+            // Pair `2i + j` holds `A`'s child `i` and `B`'s child `j`.
+            let mut keep = !apart;
+            if cross_near_leaves {
+                let leaf = pairs_of(primitives(&kids_a), primitives(&kids_b));
+                for l in 0..4 {
+                    let (a, b) = (kids_a[l >> 1], kids_b[l & 1]);
+                    if leaf >> l & 1 != 0
+                        && rel.roots_separated(a.center, a.extent, b.center, b.extent, margin)
+                    {
+                        keep &= !(1 << l);
+                    }
+                }
+            }
+            for l in (0..4).rev() {
+                let (a, b) = (kids_a[l >> 1], kids_b[l & 1]);
+                stack.put(
+                    (a.r, b.r),
+                    [a.center, a.extent, b.center, b.extent],
+                    keep >> l & 1 != 0,
                 );
-                stack.put((a, b, Kind::of(leaf, split)), carried, keep);
             }
         }
         stats.leaf_pairs += found as u64;
@@ -290,9 +323,9 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     }
 }
 
-/// The boxes a descent step tests: a node's children, each child that is a node replaced
-/// by its own two children (the step skips that level: a box test skipped only culls
-/// less). Up to four, in descent order, in lanes; `valid` marks the lanes used.
+/// The boxes a step against a primitive tests: a node's children, each child that is a
+/// node replaced by its own two children (the step skips that level: a box test skipped
+/// only culls less). Up to four, in descent order, in lanes; `valid` marks the lanes used.
 struct Below {
     kids: [Child; 4],
     valid: u32,
@@ -300,29 +333,11 @@ struct Below {
 }
 
 impl Below {
-    /// The lanes that hold a primitive.
-    #[inline(always)]
-    fn primitives(&self) -> u32 {
-        let p = |l: usize| self.kids[l].r.0 >> 31;
-        p(0) | p(1) << 1 | p(2) << 2 | p(3) << 3
-    }
-
-    /// Each lane's extent summed over the three axes (the split heuristic's measure).
-    #[inline(always)]
-    fn extent_sums(&self) -> Vec4 {
-        self.lanes.extent[0] + self.lanes.extent[1] + self.lanes.extent[2]
-    }
-
     #[inline(always)]
     fn new<L: Store>(layout: &L, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A) + Copy) -> Self {
-        let none = Child {
-            r: Ref(u32::MAX),
-            center: Vec3A::ZERO,
-            extent: Vec3A::ZERO,
-        };
         let open = |c: Child| {
             if c.r.is_primitive() {
-                ([c, none], 0b01)
+                ([c, c], 0b01)
             } else {
                 (layout.children_boxes(c.r.index(), prim), 0b11)
             }
@@ -341,51 +356,34 @@ impl Below {
     }
 }
 
-/// Every lane's bit when `on`, none otherwise.
+/// Bit `l` set for the children that are primitives.
 #[inline(always)]
-fn all_or_none(on: bool) -> u32 {
-    if on { 0b1111 } else { 0 }
+fn primitives(kids: &[Child; 2]) -> u32 {
+    kids[0].r.0 >> 31 | (kids[1].r.0 >> 31) << 1
+}
+
+/// The pairs `2i + j` whose child `i` of `A` is in `a` and child `j` of `B` in `b` (two
+/// masks of two bits).
+#[inline(always)]
+fn pairs_of(a: u32, b: u32) -> u32 {
+    (b * (a & 1)) | ((b << 2) * (a >> 1))
 }
 
 /// The descent's consumer: called once per batch of pairs of primitives whose boxes
 /// overlap, it may stop the descent.
 type OnBatch<'f> = dyn FnMut(&[(u32, u32)]) -> ControlFlow<()> + 'f;
 
-/// What a pending pair does next.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    /// Split `A`'s node; the box carried is `B`'s.
-    SplitA,
-    /// Split `B`'s node; the box carried is `A`'s.
-    SplitB,
-    /// Two primitives: the pair goes to the batch.
-    Leaf,
-}
-
-impl Kind {
-    #[inline(always)]
-    fn of(leaf: bool, split_a: bool) -> Self {
-        if leaf {
-            Kind::Leaf
-        } else if split_a {
-            Kind::SplitA
-        } else {
-            Kind::SplitB
-        }
-    }
-}
-
-/// The pairs of the descent whose boxes overlap: each says what to do next, decided when
-/// both boxes were at hand (split the node with the larger extent), and carries the other
-/// side's box (`center ± extent`), which the split's two children are tested against.
+/// The pairs of the descent whose boxes overlap, each with both boxes (`A`'s center and
+/// extent, then `B`'s): a node's children and their boxes come from the node, a primitive's
+/// box from here. Pairs of two primitives are leaves.
 ///
 /// Two arrays (the pairs, the boxes), each read back at the width it was written. An entry
 /// is written at the top whether it is kept or not, and kept by moving the top: no
 /// branch.
 #[derive(Default)]
 struct Pending {
-    pairs: Vec<(Ref, Ref, Kind)>,
-    boxes: Vec<(Vec3A, Vec3A)>,
+    pairs: Vec<(Ref, Ref)>,
+    boxes: Vec<[Vec3A; 4]>,
     top: usize,
 }
 
@@ -395,26 +393,25 @@ impl Pending {
     fn reserve(&mut self, n: usize) {
         if self.pairs.len() < self.top + n {
             let len = (self.top + n).max(2 * self.pairs.len()).max(64);
-            self.pairs.resize(len, (Ref(0), Ref(0), Kind::Leaf));
-            self.boxes.resize(len, (Vec3A::ZERO, Vec3A::ZERO));
+            self.pairs.resize(len, (Ref(0), Ref(0)));
+            self.boxes.resize(len, [Vec3A::ZERO; 4]);
         }
     }
 
-    /// Writes a pair (its references and what it does next) and the box it carries at the
-    /// top, and keeps it when `keep`. The caller reserves the room first
-    /// ([`Pending::reserve`]).
+    /// Writes a pair and its boxes at the top, and keeps it when `keep`. The caller
+    /// reserves the room first ([`Pending::reserve`]).
     #[inline(always)]
-    fn put(&mut self, pair: (Ref, Ref, Kind), carried: (Vec3A, Vec3A), keep: bool) {
+    fn put(&mut self, pair: (Ref, Ref), boxes: [Vec3A; 4], keep: bool) {
         self.pairs[self.top] = pair;
-        self.boxes[self.top] = carried;
+        self.boxes[self.top] = boxes;
         self.top += usize::from(keep);
     }
 
     /// Pops the top pair if it is a pair of primitives, as `(i, j)`.
     #[inline(always)]
     fn leaf_on_top(&mut self) -> Option<(u32, u32)> {
-        let (ra, rb, kind) = *self.pairs.get(self.top.checked_sub(1)?)?;
-        if kind != Kind::Leaf {
+        let (ra, rb) = *self.pairs.get(self.top.checked_sub(1)?)?;
+        if !(ra.is_primitive() && rb.is_primitive()) {
             return None;
         }
         self.top -= 1;
@@ -426,7 +423,8 @@ impl Pending {
     #[inline(always)]
     fn inner_on_top(&mut self) -> Option<usize> {
         let i = self.top.checked_sub(1)?;
-        if self.pairs.get(i)?.2 == Kind::Leaf {
+        let (ra, rb) = *self.pairs.get(i)?;
+        if ra.is_primitive() && rb.is_primitive() {
             return None;
         }
         self.top = i;

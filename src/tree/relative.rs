@@ -73,7 +73,7 @@
 
 use crate::kernel;
 use crate::num::{pow2, round_up, sqrt};
-use glam::{DMat3, DVec3, Quat, Vec3A, Vec4};
+use glam::{DMat3, DVec3, Quat, Vec3A, Vec4, Vec4Swizzles};
 
 use crate::transform::{Rigid3, Similarity3};
 
@@ -330,37 +330,28 @@ impl Relative {
         d.cmpgt(r).any()
     }
 
-    /// [`Relative::on_a`] on four boxes of `B` in lanes: per lane, the same bits.
+    /// The pose in lanes for the descent's steps: see [`Crosswise`].
     #[inline(always)]
-    pub(crate) fn on_a_lanes(&self, b: &Lanes) -> Lanes {
-        Lanes {
-            center: plus(lanes_times(&self.cols, &b.center), self.t32),
-            extent: lanes_times(&self.abs_cols, &b.extent),
+    pub(crate) fn crosswise(&self) -> Crosswise {
+        let lanes = |rows: [Vec3A; 3], cols: [Vec3A; 3], t_b: Vec3A, t: Vec3A| {
+            // Lanes 0 and 1 take `on_b`'s terms, lanes 2 and 3 `on_a`'s.
+            let mix = |b: Vec3A, a: Vec3A| [0, 1, 2].map(|k| Vec4::new(b[k], b[k], a[k], a[k]));
+            LanePose {
+                w: [0, 1, 2].map(|j| mix(rows[j], cols[j])),
+                t: mix(t_b, t),
+            }
+        };
+        let (rows, abs_rows, cols, abs_cols) = (self.rows, self.abs_rows, self.cols, self.abs_cols);
+        let (t_b, t) = (self.t_b, self.t32);
+        Crosswise {
+            mixed: (lanes(rows, cols, t_b, t), lanes(abs_rows, abs_cols, t_b, t)),
+            on_a: (lanes(cols, cols, t, t), lanes(abs_cols, abs_cols, t, t)),
+            on_b: (
+                lanes(rows, rows, t_b, t_b),
+                lanes(abs_rows, abs_rows, t_b, t_b),
+            ),
+            pad: Vec4::splat(self.pad),
         }
-    }
-
-    /// [`Relative::on_b`] on four boxes of `A` in lanes: per lane, the same bits.
-    #[inline(always)]
-    pub(crate) fn on_b_lanes(&self, a: &Lanes) -> Lanes {
-        Lanes {
-            center: plus(lanes_times(&self.rows, &a.center), self.t_b),
-            extent: lanes_times(&self.abs_rows, &a.extent),
-        }
-    }
-
-    /// [`Relative::apart`] per lane, as a lane mask: four boxes `boxes` against one box
-    /// placed on their axes (`placed`), or, with the roles the other way, four placed boxes
-    /// against one box `c ± e`. The same bits as `apart`, lane by lane.
-    #[inline(always)]
-    pub(crate) fn apart_lanes(&self, placed: &Lanes, boxes: &Lanes) -> u32 {
-        let pad = Vec4::splat(self.pad);
-        let mut apart = glam::BVec4A::FALSE;
-        for k in 0..3 {
-            let d = (placed.center[k] - boxes.center[k]).abs();
-            let r = placed.extent[k] + boxes.extent[k] + pad;
-            apart |= d.cmpgt(r);
-        }
-        apart.bitmask()
     }
 
     /// The same test on `min`/`max` boxes (`a` in `A`'s frame, `b` in `B`'s), read back as
@@ -485,15 +476,6 @@ pub(crate) struct Lanes {
 }
 
 impl Lanes {
-    /// One box in all four lanes.
-    #[inline(always)]
-    pub(crate) fn splat(center: Vec3A, extent: Vec3A) -> Self {
-        Lanes {
-            center: splat3(center),
-            extent: splat3(extent),
-        }
-    }
-
     /// Four boxes, `center ± extent`, one per lane.
     #[inline(always)]
     pub(crate) fn new(center: [Vec3A; 4], extent: [Vec3A; 4]) -> Self {
@@ -504,30 +486,128 @@ impl Lanes {
     }
 }
 
-/// The coordinates of `v`, each in all four lanes.
-#[inline(always)]
-fn splat3(v: Vec3A) -> [Vec4; 3] {
-    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
+/// A linear map and translation with each entry per lane: coordinate `k` of a point in
+/// lanes maps to `(w[0][k]·v_0 + w[1][k]·v_1) + w[2][k]·v_2 + t[k]`, the order of the `Vec3A`
+/// sums of [`Relative::on_a`] and [`Relative::on_b`] (so, per lane, the same bits).
+#[derive(Clone, Copy, Debug)]
+struct LanePose {
+    w: [[Vec4; 3]; 3],
+    t: [Vec4; 3],
 }
 
-/// `Σ_j m[j]·v[j]` per coordinate, in lanes: coordinate `k` is
-/// `(m[0]_k·v_0 + m[1]_k·v_1) + m[2]_k·v_2`, the order of the `Vec3A` sums of
-/// [`Relative::on_a`] and [`Relative::on_b`] (so the same bits).
-#[inline(always)]
-fn lanes_times(m: &[Vec3A; 3], v: &[Vec4; 3]) -> [Vec4; 3] {
-    let [m0, m1, m2] = m.map(splat3);
-    [
-        m0[0] * v[0] + m1[0] * v[1] + m2[0] * v[2],
-        m0[1] * v[0] + m1[1] * v[1] + m2[1] * v[2],
-        m0[2] * v[0] + m1[2] * v[1] + m2[2] * v[2],
-    ]
+impl LanePose {
+    #[inline(always)]
+    fn times(&self, v: &[Vec4; 3]) -> [Vec4; 3] {
+        let w = &self.w;
+        [0, 1, 2].map(|k| w[0][k] * v[0] + w[1][k] * v[1] + w[2][k] * v[2])
+    }
 }
 
-/// `v + t` per coordinate, in lanes.
+/// The relative pose in lanes, built once per query, for the descent's two kinds of step:
+/// - a step that splits a node of each tree holds two children of `A` in lanes 0 and 1 and
+///   two of `B` in lanes 2 and 3; [`Crosswise::place`] places all four on the other tree's
+///   axes at once ([`Relative::on_b`] in lanes 0 and 1, [`Relative::on_a`] in lanes 2 and
+///   3), and [`Crosswise::apart_pairs`] tests the four pairs of a child of each;
+/// - a step against a primitive holds four boxes of the other tree;
+///   [`Crosswise::place_on`] places them and [`Crosswise::apart_from`] tests them against
+///   the primitive's box.
+///
+/// Per lane, the same bits as the one-box test [`Relative::overlaps_ce`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Crosswise {
+    /// `(M or N, |M| or |N|)` per lane: `N` in lanes 0 and 1, `M` in lanes 2 and 3.
+    mixed: (LanePose, LanePose),
+    /// `M` in every lane (boxes of `B` onto `A`'s axes).
+    on_a: (LanePose, LanePose),
+    /// `N` in every lane (boxes of `A` onto `B`'s axes).
+    on_b: (LanePose, LanePose),
+    pad: Vec4,
+}
+
+/// Which tree's axes boxes in lanes are placed on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Axes {
+    /// `A`'s: the boxes are `B`'s.
+    OfA,
+    /// `B`'s: the boxes are `A`'s.
+    OfB,
+}
+
+/// Boxes `x` placed by `(map, |map|)`.
 #[inline(always)]
-fn plus(v: [Vec4; 3], t: Vec3A) -> [Vec4; 3] {
-    let t = splat3(t);
-    [v[0] + t[0], v[1] + t[1], v[2] + t[2]]
+fn placed_by(pose: &(LanePose, LanePose), x: &Lanes) -> Lanes {
+    let c = pose.0.times(&x.center);
+    Lanes {
+        center: [0, 1, 2].map(|k| c[k] + pose.0.t[k]),
+        extent: pose.1.times(&x.extent),
+    }
+}
+
+impl Crosswise {
+    /// Two boxes of `A` (lanes 0, 1) and two of `B` (lanes 2, 3), each placed on the other
+    /// tree's axes.
+    #[inline(always)]
+    pub(crate) fn place(&self, x: &Lanes) -> Lanes {
+        placed_by(&self.mixed, x)
+    }
+
+    /// Four boxes of one tree placed on `axes`, the other tree's.
+    #[inline(always)]
+    pub(crate) fn place_on(&self, axes: Axes, x: &Lanes) -> Lanes {
+        placed_by(
+            if axes == Axes::OfA {
+                &self.on_a
+            } else {
+                &self.on_b
+            },
+            x,
+        )
+    }
+
+    /// The pairs of a child of each tree that the 6-axis test separates, as a mask: bit
+    /// `2i + j` for `A`'s child in lane `i` and `B`'s child in lane `2 + j`. `placed` is
+    /// [`Crosswise::place`] of `x`.
+    #[inline(always)]
+    pub(crate) fn apart_pairs(&self, x: &Lanes, placed: &Lanes) -> u32 {
+        // Lanes per pair `(i, j)`: `A`'s side repeated (`xxyy`), `B`'s alternated (`zwzw`).
+        let mut apart = glam::BVec4A::FALSE;
+        for k in 0..3 {
+            let (a_c, a_e) = (x.center[k].xxyy(), x.extent[k].xxyy());
+            let (b_c, b_e) = (x.center[k].zwzw(), x.extent[k].zwzw());
+            // `B`'s children on `A`'s axes, against `A`'s children.
+            let (on_a_c, on_a_e) = (placed.center[k].zwzw(), placed.extent[k].zwzw());
+            apart |= (on_a_c - a_c).abs().cmpgt(on_a_e + a_e + self.pad);
+            // `A`'s children on `B`'s axes, against `B`'s children.
+            let (on_b_c, on_b_e) = (placed.center[k].xxyy(), placed.extent[k].xxyy());
+            apart |= (on_b_c - b_c).abs().cmpgt(on_b_e + b_e + self.pad);
+        }
+        apart.bitmask()
+    }
+
+    /// The boxes `x` of one tree that the 6-axis test separates from the box `c ± e` of
+    /// the other, as a lane mask: `x_placed` is `x` placed on the other tree's axes
+    /// ([`Crosswise::place_on`]) and `placed` the one box placed on `x`'s tree's axes.
+    #[inline(always)]
+    pub(crate) fn apart_from(
+        &self,
+        x: &Lanes,
+        x_placed: &Lanes,
+        (c, e): (Vec3A, Vec3A),
+        placed: &Placed,
+    ) -> u32 {
+        let mut apart = glam::BVec4A::FALSE;
+        for k in 0..3 {
+            // `x` on the other tree's axes, against the one box.
+            let (c, e) = (Vec4::splat(c[k]), Vec4::splat(e[k]));
+            apart |= (x_placed.center[k] - c)
+                .abs()
+                .cmpgt(x_placed.extent[k] + e + self.pad);
+            // The one box on `x`'s tree's axes, against `x`.
+            let (pc, pe) = (Vec4::splat(placed.center[k]), Vec4::splat(placed.reach[k]));
+            apart |= (pc - x.center[k]).abs().cmpgt(pe + x.extent[k] + self.pad);
+        }
+        apart.bitmask()
+    }
 }
 
 #[cfg(test)]
@@ -563,14 +643,15 @@ mod tests {
         }
     }
 
-    /// Four boxes in lanes give, lane by lane, the same placed bits and answers as one at
-    /// a time, either side in lanes.
+    /// Two boxes of each tree in lanes, placed crosswise, give lane by lane the placed
+    /// bits of `on_b` and `on_a`, and pair by pair the answer of `overlaps_ce`; four boxes
+    /// of either tree against one box of the other, the same.
     #[test]
-    fn boxes_in_lanes_give_the_same_bits() {
+    fn boxes_placed_crosswise_give_the_same_bits() {
         let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
         let mut next = move || next() as f32;
-        let (mut apart, mut near) = (0, 0);
-        for _ in 0..100 {
+        let (mut apart, mut near, mut one_near) = (0, 0, 0);
+        for _ in 0..200 {
             let mut pose = || Rigid3 {
                 rotation: Quat::from_xyzw(next(), next(), next(), next()).normalize(),
                 translation: Vec3A::new(next(), next(), next()) * 0.5,
@@ -578,32 +659,66 @@ mod tests {
             let (pa, pb) = (pose(), pose());
             let rel = Relative::new(&pa, 4.0, &pb, 4.0, 0.0).expect("a finite pose");
             let mut corner = || Vec3A::new(next(), next(), next());
-            let boxes: [(Vec3A, Vec3A); 5] = core::array::from_fn(|_| (corner(), corner().abs()));
-            let [(c, e), rest @ ..] = boxes;
-            let lanes = Lanes::new(rest.map(|b| b.0), rest.map(|b| b.1));
-            let one = Lanes::splat(c, e);
-            // `rest` in A's frame, the one box in B's; then the other way round.
-            let a_side = rel.apart_lanes(&rel.on_a_lanes(&one), &lanes)
-                | rel.apart_lanes(&rel.on_b_lanes(&lanes), &one);
-            let b_side = rel.apart_lanes(&rel.on_a_lanes(&lanes), &one)
-                | rel.apart_lanes(&rel.on_b_lanes(&one), &lanes);
-            let placed = rel.on_b_lanes(&lanes);
-            for (l, &(cl, el)) in rest.iter().enumerate() {
-                let p = rel.on_b(cl, el);
-                let lane = |v: &[Vec4; 3]| Vec3A::new(v[0][l], v[1][l], v[2][l]);
-                assert_eq!(lane(&placed.center).to_array(), p.center.to_array());
-                assert_eq!(lane(&placed.extent).to_array(), p.reach.to_array());
-                let overlaps_a = rel.overlaps_ce(cl, el, c, e);
-                assert_eq!(a_side >> l & 1 == 0, overlaps_a);
-                assert_eq!(b_side >> l & 1 == 0, rel.overlaps_ce(c, e, cl, el));
-                if overlaps_a {
-                    near += 1;
+            // Lanes 0 and 1: boxes of `A`; lanes 2 and 3: boxes of `B`.
+            let boxes: [(Vec3A, Vec3A); 4] = core::array::from_fn(|_| (corner(), corner().abs()));
+            let x = Lanes::new(boxes.map(|b| b.0), boxes.map(|b| b.1));
+            let cross = rel.crosswise();
+            let placed = cross.place(&x);
+            let lane = |v: &[Vec4; 3], l: usize| Vec3A::new(v[0][l], v[1][l], v[2][l]);
+            for (l, &(c, e)) in boxes.iter().enumerate() {
+                let p = if l < 2 {
+                    rel.on_b(c, e)
                 } else {
-                    apart += 1;
+                    rel.on_a(c, e)
+                };
+                assert_eq!(lane(&placed.center, l).to_array(), p.center.to_array());
+                assert_eq!(lane(&placed.extent, l).to_array(), p.reach.to_array());
+            }
+            // Four boxes of either tree against one of the other.
+            let (c, e) = (corner(), corner().abs());
+            for axes in [Axes::OfA, Axes::OfB] {
+                let x_placed = cross.place_on(axes, &x);
+                let of_a = axes == Axes::OfA;
+                let one_placed = if of_a { rel.on_b(c, e) } else { rel.on_a(c, e) };
+                let p = |c, e| if of_a { rel.on_a(c, e) } else { rel.on_b(c, e) };
+                let mask = cross.apart_from(&x, &x_placed, (c, e), &one_placed);
+                for (l, &(cl, el)) in boxes.iter().enumerate() {
+                    assert_eq!(
+                        lane(&x_placed.center, l).to_array(),
+                        p(cl, el).center.to_array()
+                    );
+                    assert_eq!(
+                        lane(&x_placed.extent, l).to_array(),
+                        p(cl, el).reach.to_array()
+                    );
+                    let overlaps = if of_a {
+                        rel.overlaps_ce(c, e, cl, el)
+                    } else {
+                        rel.overlaps_ce(cl, el, c, e)
+                    };
+                    assert_eq!(mask >> l & 1 == 0, overlaps);
+                    one_near += usize::from(overlaps);
+                }
+            }
+            let mask = cross.apart_pairs(&x, &placed);
+            for i in 0..2 {
+                for j in 0..2 {
+                    let ((ca, ea), (cb, eb)) = (boxes[i], boxes[2 + j]);
+                    let overlaps = rel.overlaps_ce(ca, ea, cb, eb);
+                    assert_eq!(mask >> (2 * i + j) & 1 == 0, overlaps);
+                    if overlaps {
+                        near += 1;
+                    } else {
+                        apart += 1;
+                    }
                 }
             }
         }
-        assert!(apart > 50 && near > 50, "{apart} apart, {near} near");
+        assert!(apart > 100 && near > 100, "{apart} apart, {near} near");
+        assert!(
+            one_near > 200 && one_near < 1400,
+            "{one_near} of 1,600 near one box"
+        );
     }
 
     /// A box placed once gives `overlaps_ce`'s answer on every pair, either side placed.
