@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3A};
 
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Child, Layout, Ref, Store};
-use super::relative::{Axes, Lanes, QueryError, Relative};
+use super::relative::{Axes, Crosswise, Lanes, QueryError, Relative};
 use super::triangle::{LANES, TriangleLanes, filter, triangles_distance_sq, triangles_intersect};
 use crate::transform::{Rigid3, Similarity3};
 
@@ -213,7 +213,6 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         // Each pair on the stack passed its box test; the stack's top is the next pair in
         // descent order, leaves included, so pairs of primitives leave in that order.
         let mut stack = Pending::default();
-        stack.reserve(1);
         stack.put((ha.root, hb.root), [ca, ea, cb, eb], true);
         let mut leaves = [(0u32, 0u32); LANES];
         let mut found = 0;
@@ -236,43 +235,26 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                 break;
             };
             let ((ra, rb), [ca, ea, cb, eb]) = (stack.pairs[i], stack.boxes[i]);
-            stack.reserve(4);
-            if ra.is_primitive() || rb.is_primitive() {
-                // One side is a primitive: up to four boxes below the other side's node
-                // (`Below`), placed on the primitive's tree's axes, against its box.
-                let (below, axes) = if ra.is_primitive() {
-                    (Below::new(lb, rb.index(), prim_b), Axes::OfA)
-                } else {
-                    (Below::new(la, ra.index(), prim_a), Axes::OfB)
-                };
-                let x_placed = cross.place_on(axes, &below.lanes);
-                let apart = if axes == Axes::OfA {
-                    cross.apart_from(&below.lanes, &x_placed, (ca, ea), &rel.on_b(ca, ea))
-                } else {
-                    cross.apart_from(&below.lanes, &x_placed, (cb, eb), &rel.on_a(cb, eb))
-                };
+            // One side is a primitive: up to four boxes below the other side's node
+            // (`Below`), placed on the primitive's tree's axes, against its box.
+            if ra.is_primitive() {
+                let below = Below::new(lb, rb.index(), prim_b);
+                let keep = self.keep_against(&cross, &below, Axes::OfA, (ca, ea), margin);
                 stats.node_pairs += u64::from(below.valid.count_ones());
-                let mut keep = below.valid & !apart;
-                if cross_near_leaves {
-                    for (l, kid) in below.kids.iter().enumerate() {
-                        let (a, b) = if axes == Axes::OfA {
-                            ((ca, ea), (kid.center, kid.extent))
-                        } else {
-                            ((kid.center, kid.extent), (cb, eb))
-                        };
-                        if kid.r.is_primitive() && rel.roots_separated(a.0, a.1, b.0, b.1, margin) {
-                            keep &= !(1 << l);
-                        }
-                    }
-                }
-                for (l, kid) in below.kids.iter().enumerate().rev() {
-                    let entry = if axes == Axes::OfA {
-                        ((ra, kid.r), [ca, ea, kid.center, kid.extent])
-                    } else {
-                        ((kid.r, rb), [kid.center, kid.extent, cb, eb])
-                    };
-                    stack.put(entry.0, entry.1, keep >> l & 1 != 0);
-                }
+                stack.push_kept(keep, |l| {
+                    let k = below.kids[l];
+                    ((ra, k.r), [ca, ea, k.center, k.extent])
+                });
+                continue;
+            }
+            if rb.is_primitive() {
+                let below = Below::new(la, ra.index(), prim_a);
+                let keep = self.keep_against(&cross, &below, Axes::OfB, (cb, eb), margin);
+                stats.node_pairs += u64::from(below.valid.count_ones());
+                stack.push_kept(keep, |l| {
+                    let k = below.kids[l];
+                    ((k.r, rb), [k.center, k.extent, cb, eb])
+                });
                 continue;
             }
             // Both nodes split: two children of `A` in lanes 0 and 1, two of `B` in lanes 2
@@ -309,17 +291,56 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                     }
                 }
             }
-            for l in (0..4).rev() {
+            stack.push_kept(keep, |l| {
                 let (a, b) = (kids_a[l >> 1], kids_b[l & 1]);
-                stack.put(
-                    (a.r, b.r),
-                    [a.center, a.extent, b.center, b.extent],
-                    keep >> l & 1 != 0,
-                );
-            }
+                ((a.r, b.r), [a.center, a.extent, b.center, b.extent])
+            });
         }
         stats.leaf_pairs += found as u64;
         (batch(&leaves[..found]), stats)
+    }
+}
+
+impl<A: Shape, B: Shape> Query<'_, A, B> {
+    /// The boxes of `below` (one tree's) that pass the box test against the box `one` of
+    /// the other tree (a primitive), as a lane mask; `axes` are the primitive's tree's.
+    /// With the cross axes near leaves, a pair of primitives must pass them too.
+    #[inline(always)]
+    fn keep_against(
+        &self,
+        cross: &Crosswise,
+        below: &Below,
+        axes: Axes,
+        one: (Vec3A, Vec3A),
+        margin: f64,
+    ) -> u32 {
+        let rel = &self.relative;
+        let (placed, one_placed) = if axes == Axes::OfA {
+            (
+                cross.place_on(Axes::OfA, &below.lanes),
+                rel.on_b(one.0, one.1),
+            )
+        } else {
+            (
+                cross.place_on(Axes::OfB, &below.lanes),
+                rel.on_a(one.0, one.1),
+            )
+        };
+        let mut keep = below.valid & !cross.apart_from(&below.lanes, &placed, one, &one_placed);
+        if self.cross_near_leaves {
+            for (l, kid) in below.kids.iter().enumerate() {
+                let kid_box = (kid.center, kid.extent);
+                let ((ca, ea), (cb, eb)) = if axes == Axes::OfA {
+                    (one, kid_box)
+                } else {
+                    (kid_box, one)
+                };
+                if kid.r.is_primitive() && rel.roots_separated(ca, ea, cb, eb, margin) {
+                    keep &= !(1 << l);
+                }
+            }
+        }
+        keep
     }
 }
 
@@ -398,13 +419,37 @@ impl Pending {
         }
     }
 
-    /// Writes a pair and its boxes at the top, and keeps it when `keep`. The caller
-    /// reserves the room first ([`Pending::reserve`]).
+    /// Writes a pair and its boxes at the top, and keeps it when `keep` (the root).
     #[inline(always)]
     fn put(&mut self, pair: (Ref, Ref), boxes: [Vec3A; 4], keep: bool) {
+        self.reserve(1);
         self.pairs[self.top] = pair;
         self.boxes[self.top] = boxes;
         self.top += usize::from(keep);
+    }
+
+    /// Writes a step's four entries `entry(3)`, …, `entry(0)` at the top, in that order
+    /// (`entry(0)` ends on top), each kept when its bit of `keep` is set. Every entry is
+    /// written, and kept by moving the top: no branch, and one bounds check for the four.
+    #[inline(always)]
+    fn push_kept(&mut self, keep: u32, entry: impl Fn(usize) -> ((Ref, Ref), [Vec3A; 4])) {
+        self.reserve(4);
+        let top = self.top;
+        let (Some(pairs), Some(boxes)) = (
+            self.pairs[top..].first_chunk_mut::<4>(),
+            self.boxes[top..].first_chunk_mut::<4>(),
+        ) else {
+            unreachable!("four entries were reserved past the top");
+        };
+        let mut kept = 0;
+        for l in (0..4).rev() {
+            let (pair, b) = entry(l);
+            // `kept` is at most 3 here: the mask only spares the bounds check.
+            pairs[kept & 3] = pair;
+            boxes[kept & 3] = b;
+            kept += (keep >> l & 1) as usize;
+        }
+        self.top = top + kept;
     }
 
     /// Pops the top pair if it is a pair of primitives, as `(i, j)`.
