@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3, Vec3A};
 
 use super::build::{self, PrimBox};
 use super::nodes::{Compact, Layout, PRIMITIVE, Ref};
+use super::triangle::Soup;
 use crate::aabb::Aabb3;
 
 /// Why a mesh or a tree could not be built or refitted.
@@ -284,8 +285,16 @@ impl<L: Layout> TriMesh<L> {
     /// were checked at the build).
     #[inline(always)]
     pub(crate) fn corners(&self, i: u32) -> [Vec3; 3] {
-        let t = self.triangles[i as usize];
-        t.map(|v| self.vertices[v as usize])
+        self.soup().corners(i)
+    }
+
+    /// The vertices and triangles, as a batch of triangle tests reads them.
+    #[inline(always)]
+    pub(crate) fn soup(&self) -> Soup<'_> {
+        Soup {
+            vertices: &self.vertices,
+            triangles: &self.triangles,
+        }
     }
 
     /// The bytes of the tree's nodes (vertices and triangles not included).

@@ -9,7 +9,9 @@ use glam::{DVec3, Vec3A};
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
 use super::nodes::{Child, Layout, Ref, Store};
 use super::relative::{Axes, Crosswise, Lanes, QueryError, Relative};
-use super::triangle::{LANES, TriangleLanes, filter, triangles_distance_sq, triangles_intersect};
+use super::triangle::{
+    LANES, TriangleLanes, filter_batch, triangles_distance_sq, triangles_intersect,
+};
 use crate::transform::{Rigid3, Similarity3};
 
 /// What a tree is built over: [`TriMesh`] or [`AabbTree`] (sealed).
@@ -518,21 +520,8 @@ impl<'a, LA: Layout, LB: Layout> Query<'a, TriMesh<LA>, TriMesh<LB>> {
         if self.tolerance > 0.0 || batch.len() < 4 {
             return self.meet_one_by_one(batch, f);
         }
+        let verdicts = filter_batch(self.a.soup(), self.b.soup(), &self.relative, batch, lanes);
         let (a, b) = lanes;
-        for (l, &(i, j)) in (0..LANES).zip(batch) {
-            let (ta, tb) = (self.a.corners(i), self.b.corners(j));
-            for k in 0..3 {
-                for c in 0..3 {
-                    a[k][c][l] = f64::from(ta[k][c]);
-                    b[k][c][l] = f64::from(tb[k][c]);
-                }
-            }
-        }
-        // `B`'s corners placed in `A`'s frame, all lanes at once.
-        for corner in b.iter_mut() {
-            self.relative.place_lanes(corner);
-        }
-        let verdicts = filter(a, b);
         let corners = |t: &TriangleLanes, l: usize| {
             [0, 1, 2].map(|k| DVec3::new(t[k][0][l], t[k][1][l], t[k][2][l]))
         };

@@ -278,7 +278,7 @@ impl Relative {
     /// [`Relative::place`] on points in lanes, in place: `p[c][l]` is coordinate `c` of
     /// point `l` (an `f32` value in `f64`). The same operations in the same order as
     /// `place` (`((M₀·x + M₁·y) + M₂·z) + t`, unfused), so the same bits, lane by lane.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn place_lanes<const N: usize>(&self, p: &mut [[f64; N]; 3]) {
         let [m0, m1, m2] = [self.m.x_axis, self.m.y_axis, self.m.z_axis];
         let [x, y, z] = *p;

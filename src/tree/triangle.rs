@@ -16,8 +16,9 @@
 //! three coordinate planes intersect: one of the three projections (along an axis the plane's
 //! normal, or the common line's direction, does not lie across) is injective on them.
 
+use super::relative::Relative;
 use crate::num::pow2;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use robust::{Coord, Coord3D, orient2d, orient3d};
 
 #[inline(always)]
@@ -162,49 +163,102 @@ pub(crate) struct Verdicts {
     pub meet: [bool; LANES],
 }
 
-/// The filtered opening of [`triangles_intersect`] on a batch in lanes: the plane-side
-/// rejection of [`plane_signs`] both ways, then, where every sign is certain and both
-/// triangles cross the other's plane, Guigue and Devillers' two orientations of
-/// [`crossing`] by the same filter. Each decision is the one the scalar test makes from the
-/// same signs, taken only where the filter proves the sign of the exact determinant. Plain
-/// array code, run in the best backend's dispatch wrapper so that it vectorises.
-pub(crate) fn filter(a: &TriangleLanes, b: &TriangleLanes) -> Verdicts {
+/// The filtered opening of [`triangles_intersect`] on a batch of pairs `(i, j)`, triangle
+/// `i` of `a` and triangle `j` of `b` placed in `A`'s frame by `rel`, loaded into `lanes`
+/// (lanes past the batch keep earlier triangles): the plane-side rejection of
+/// [`plane_signs`] both ways, then, where every sign is certain and both triangles cross
+/// the other's plane, Guigue and Devillers' two orientations of [`crossing`] by the same
+/// filter. Each decision is the one the scalar test makes from the same signs, taken only
+/// where the filter proves the sign of the exact determinant. Plain array code, run with
+/// the loads and the placement in the best backend's dispatch wrapper so that it
+/// vectorises; compiled once, in the library, whatever the meshes' layouts.
+pub(crate) fn filter_batch(
+    a: Soup<'_>,
+    b: Soup<'_>,
+    rel: &Relative,
+    batch: &[(u32, u32)],
+    lanes: &mut (TriangleLanes, TriangleLanes),
+) -> Verdicts {
     crate::simd::plain(
         #[inline(always)]
         || {
-            // The signs of `b`'s corners against `a`'s plane, and of `a`'s against `b`'s,
-            // in straight-line loops over the lanes (they vectorise).
-            let (sb, sa) = (plane_sides(a, b), plane_sides(b, a));
-            let mut v = Verdicts::default();
-            let mut crossing_lanes = [false; LANES];
-            for l in 0..LANES {
-                let aside = |s: &[[Sign; LANES]; 3]| {
-                    (s[0][l].above & s[1][l].above & s[2][l].above)
-                        | (s[0][l].below & s[1][l].below & s[2][l].below)
-                };
-                let certain =
-                    |s: &[[Sign; LANES]; 3]| (0..3).all(|k| s[k][l].above | s[k][l].below);
-                v.apart[l] = aside(&sb) | aside(&sa);
-                crossing_lanes[l] = !v.apart[l] & certain(&sa) & certain(&sb);
-            }
-            // Both cross strictly: `crossing`'s rotation and swaps, then its two signs.
-            for l in 0..LANES {
-                if !crossing_lanes[l] {
-                    continue;
+            let (la, lb) = lanes;
+            for (l, &(i, j)) in (0..LANES).zip(batch) {
+                let (ta, tb) = (a.corners(i), b.corners(j));
+                for k in 0..3 {
+                    for c in 0..3 {
+                        la[k][c][l] = f64::from(ta[k][c]);
+                        lb[k][c][l] = f64::from(tb[k][c]);
+                    }
                 }
-                let corner = |t: &TriangleLanes, k: usize| [t[k][0][l], t[k][1][l], t[k][2][l]];
-                let ta = [corner(a, 0), corner(a, 1), corner(a, 2)];
-                let tb = [corner(b, 0), corner(b, 1), corner(b, 2)];
-                let signs = |s: &[[Sign; LANES]; 3]| [s[0][l].of(), s[1][l].of(), s[2][l].of()];
-                let (sa, sb) = (signs(&sa), signs(&sb));
-                let [[a0, a1, a2, a3], [b0, b1, b2, b3]] = crossing_corners(ta, tb, sa, sb);
-                let (o1, o2) = (orientation(a0, a1, a2, a3), orientation(b0, b1, b2, b3));
-                v.apart[l] = o1.above | o2.above;
-                v.meet[l] = o1.below & o2.below;
             }
-            v
+            // `B`'s corners placed in `A`'s frame, all lanes at once.
+            for corner in lb.iter_mut() {
+                rel.place_lanes(corner);
+            }
+            verdicts(la, lb)
         },
     )
+}
+
+/// The tests of [`filter_batch`] on triangles already in lanes, `b`'s placed.
+#[inline(always)]
+fn verdicts(a: &TriangleLanes, b: &TriangleLanes) -> Verdicts {
+    // The signs of `b`'s corners against `a`'s plane, and of `a`'s against `b`'s,
+    // in straight-line loops over the lanes (they vectorise).
+    let (sb, sa) = (plane_sides(a, b), plane_sides(b, a));
+    let mut v = Verdicts::default();
+    let mut crossing_lanes = [false; LANES];
+    for l in 0..LANES {
+        let aside = |s: &[[Sign; LANES]; 3]| {
+            (s[0][l].above & s[1][l].above & s[2][l].above)
+                | (s[0][l].below & s[1][l].below & s[2][l].below)
+        };
+        let certain = |s: &[[Sign; LANES]; 3]| (0..3).all(|k| s[k][l].above | s[k][l].below);
+        v.apart[l] = aside(&sb) | aside(&sa);
+        crossing_lanes[l] = !v.apart[l] & certain(&sa) & certain(&sb);
+    }
+    // Both cross strictly: `crossing`'s rotation and swaps, then its two signs.
+    for l in 0..LANES {
+        if !crossing_lanes[l] {
+            continue;
+        }
+        let corner = |t: &TriangleLanes, k: usize| [t[k][0][l], t[k][1][l], t[k][2][l]];
+        let ta = [corner(a, 0), corner(a, 1), corner(a, 2)];
+        let tb = [corner(b, 0), corner(b, 1), corner(b, 2)];
+        let signs = |s: &[[Sign; LANES]; 3]| [s[0][l].of(), s[1][l].of(), s[2][l].of()];
+        let (sa, sb) = (signs(&sa), signs(&sb));
+        let [[a0, a1, a2, a3], [b0, b1, b2, b3]] = crossing_corners(ta, tb, sa, sb);
+        let (o1, o2) = (orientation(a0, a1, a2, a3), orientation(b0, b1, b2, b3));
+        v.apart[l] = o1.above | o2.above;
+        v.meet[l] = o1.below & o2.below;
+    }
+    v
+}
+
+/// [`verdicts`] in the dispatch wrapper, as [`filter_batch`] runs it.
+#[cfg(test)]
+fn filter(a: &TriangleLanes, b: &TriangleLanes) -> Verdicts {
+    crate::simd::plain(
+        #[inline(always)]
+        || verdicts(a, b),
+    )
+}
+
+/// A mesh's triangles as a batch reads them: its vertices, and each triangle's three
+/// vertex indices (checked when the mesh was built).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Soup<'a> {
+    pub vertices: &'a [Vec3],
+    pub triangles: &'a [[u32; 3]],
+}
+
+impl Soup<'_> {
+    /// The corners of triangle `i`.
+    #[inline(always)]
+    pub(crate) fn corners(&self, i: u32) -> [Vec3; 3] {
+        self.triangles[i as usize].map(|v| self.vertices[v as usize])
+    }
 }
 
 /// Per corner `k` of `u` and lane `l`, the sign of `O(t₀, t₁, t₂, u_k)` where the filter
