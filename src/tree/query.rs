@@ -163,10 +163,11 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     /// `batch`, in descent order, in batches of at least `flush_at` pairs (the last one
     /// excepted) and at most [`LANES`], until it breaks.
     ///
-    /// A step pops a pair and splits both nodes (a primitive stays itself): the pairs of a
-    /// child of each, up to four, are tested at once in lanes (`Crosswise`); the pairs
-    /// that pass go on the stack, and pairs of primitives leave it for the batch. The triangle tests then run on a whole
-    /// batch at once (a lane filter first).
+    /// A step pops a pair and splits both nodes, testing the four pairs of a child of each
+    /// at once in lanes; when one side is a primitive, it opens the other node two levels
+    /// and tests up to four boxes against the primitive's (`Crosswise`). The pairs that
+    /// pass go on the stack, and pairs of primitives leave it for the batch. The triangle
+    /// tests then run on a whole batch at once (a lane filter first).
     ///
     /// `batch` is called through a reference to a trait object, once per batch: the
     /// descent is compiled once per pair of shapes and backend in the user's crate, not
