@@ -11,6 +11,7 @@ use bvkit::{
 use glam::{Vec2, Vec3A};
 use rand::RngExt;
 use rand::rngs::StdRng;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::cases::{Class, Scale, as_translation, bend_quat, problem, rng};
 use crate::oracle::{
@@ -21,7 +22,7 @@ use crate::oracle::{
 pub const CASES: u64 = 400;
 
 /// A generator of the problems of one extreme class.
-type Generator = Box<dyn Fn(&mut StdRng) -> Problem<3>>;
+type Generator = Box<dyn Fn(&mut StdRng) -> Problem<3> + Send + Sync>;
 
 fn from_class(class: Class) -> impl Fn(&mut StdRng) -> Problem<3> {
     move |r| problem::<3>(class, r)
@@ -259,68 +260,98 @@ fn cell2<T: Transform2>(
     }
 }
 
-/// Computes the matrix: `cells[table][row][kernel]`.
+/// Computes the matrix: `cells[table][row][kernel]`. The rows are independent (each seeds
+/// its own generator), so the available cores take them in turn: the same cells, in less
+/// time.
 pub fn compute() -> Vec<Vec<Vec<Cell>>> {
     let rows = rows();
     let kernels = kernels();
-    let mut cells = vec![vec![vec![Cell::default(); kernels.len()]; rows.len()]; TABLES.len()];
-    for (ri, (_, make, class)) in rows.iter().enumerate() {
-        let r = &mut rng(0x57ab ^ ri as u64);
-        let ps: Vec<Problem<3>> = (0..CASES).map(|_| make(r)).collect();
-        let translations: Vec<Problem<3>> = ps.iter().map(|p| as_translation(*p)).collect();
-        let quats = |scale, r: &mut StdRng| -> Vec<QuatProblem> {
-            ps.iter().map(|p| bend_quat(*p, *class, scale, r)).collect()
+    let next = AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let done: Vec<(usize, Vec<Vec<Cell>>)> = std::thread::scope(|s| {
+        let take = || {
+            let mut done = Vec::new();
+            loop {
+                let ri = next.fetch_add(1, Ordering::Relaxed);
+                let Some(row) = rows.get(ri) else {
+                    return done;
+                };
+                done.push((ri, row_cells(ri, row, &kernels)));
+            }
         };
-        let (rigid3, similarity3, trs3) = (
-            quats(Scale::Unit, r),
-            quats(Scale::Uniform, r),
-            quats(Scale::PerAxis, r),
-        );
-        let ps2: Vec<Problem<2>> = ps.iter().map(planar).collect();
-        let rigid2s: Vec<Problem<2>> = ps2
-            .iter()
-            .map(|p| Problem {
-                cols: [[p.cols[0][0], p.cols[0][1]], [-p.cols[0][1], p.cols[0][0]]],
-                ..*p
-            })
+        let handles: Vec<_> = (0..workers.min(rows.len()))
+            .map(|_| s.spawn(take))
             .collect();
-        let translations2: Vec<Problem<2>> = ps2.iter().map(|p| as_translation(*p)).collect();
-        for (ki, &(m, rd)) in kernels.iter().enumerate() {
-            cell3(&mut cells[0][ri][ki], &ps, affine3, m, rd);
-            let translation = |p: &Problem<3>| {
-                let (b, _) = affine3(p);
-                (b, Translation3(Vec3A::from_array(p.t)))
-            };
-            cell3(&mut cells[1][ri][ki], &translations, translation, m, rd);
-            cell3(
-                &mut cells[2][ri][ki],
-                &rigid3,
-                |p| (p.aabb(), p.rigid3()),
-                m,
-                rd,
-            );
-            cell3(
-                &mut cells[3][ri][ki],
-                &similarity3,
-                |p| (p.aabb(), p.similarity3()),
-                m,
-                rd,
-            );
-            cell3(
-                &mut cells[4][ri][ki],
-                &trs3,
-                |p| (p.aabb(), p.trs3()),
-                m,
-                rd,
-            );
-            cell2(&mut cells[5][ri][ki], &ps2, affine2, m, rd);
-            cell2(&mut cells[6][ri][ki], &rigid2s, rigid2, m, rd);
-            let translation2 = |p: &Problem<2>| {
-                let (b, _) = affine2(p);
-                (b, Translation2(Vec2::from_array(p.t)))
-            };
-            cell2(&mut cells[7][ri][ki], &translations2, translation2, m, rd);
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    let mut cells = vec![vec![Vec::new(); rows.len()]; TABLES.len()];
+    for (ri, tables) in done {
+        for (table, row) in cells.iter_mut().zip(tables) {
+            table[ri] = row;
         }
+    }
+    cells
+}
+
+/// Row `ri`'s cells, `[table][kernel]`.
+fn row_cells(
+    ri: usize,
+    (_, make, class): &(&'static str, Generator, Class),
+    kernels: &[(Method, Rounding)],
+) -> Vec<Vec<Cell>> {
+    let mut cells = vec![vec![Cell::default(); kernels.len()]; TABLES.len()];
+    let r = &mut rng(0x57ab ^ ri as u64);
+    let ps: Vec<Problem<3>> = (0..CASES).map(|_| make(r)).collect();
+    let translations: Vec<Problem<3>> = ps.iter().map(|p| as_translation(*p)).collect();
+    let quats = |scale, r: &mut StdRng| -> Vec<QuatProblem> {
+        ps.iter().map(|p| bend_quat(*p, *class, scale, r)).collect()
+    };
+    let (rigid3, similarity3, trs3) = (
+        quats(Scale::Unit, r),
+        quats(Scale::Uniform, r),
+        quats(Scale::PerAxis, r),
+    );
+    let ps2: Vec<Problem<2>> = ps.iter().map(planar).collect();
+    let rigid2s: Vec<Problem<2>> = ps2
+        .iter()
+        .map(|p| Problem {
+            cols: [[p.cols[0][0], p.cols[0][1]], [-p.cols[0][1], p.cols[0][0]]],
+            ..*p
+        })
+        .collect();
+    let translations2: Vec<Problem<2>> = ps2.iter().map(|p| as_translation(*p)).collect();
+    for (ki, &(m, rd)) in kernels.iter().enumerate() {
+        cell3(&mut cells[0][ki], &ps, affine3, m, rd);
+        let translation = |p: &Problem<3>| {
+            let (b, _) = affine3(p);
+            (b, Translation3(Vec3A::from_array(p.t)))
+        };
+        cell3(&mut cells[1][ki], &translations, translation, m, rd);
+        cell3(
+            &mut cells[2][ki],
+            &rigid3,
+            |p| (p.aabb(), p.rigid3()),
+            m,
+            rd,
+        );
+        cell3(
+            &mut cells[3][ki],
+            &similarity3,
+            |p| (p.aabb(), p.similarity3()),
+            m,
+            rd,
+        );
+        cell3(&mut cells[4][ki], &trs3, |p| (p.aabb(), p.trs3()), m, rd);
+        cell2(&mut cells[5][ki], &ps2, affine2, m, rd);
+        cell2(&mut cells[6][ki], &rigid2s, rigid2, m, rd);
+        let translation2 = |p: &Problem<2>| {
+            let (b, _) = affine2(p);
+            (b, Translation2(Vec2::from_array(p.t)))
+        };
+        cell2(&mut cells[7][ki], &translations2, translation2, m, rd);
     }
     cells
 }
