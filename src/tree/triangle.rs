@@ -181,7 +181,7 @@ pub(crate) fn filter_batch(
 ) -> Verdicts {
     crate::simd::plain(
         #[inline(always)]
-        || {
+        move || {
             let (la, lb) = lanes;
             for (l, &(i, j)) in (0..LANES).zip(batch) {
                 let (ta, tb) = (a.corners(i), b.corners(j));
