@@ -220,10 +220,12 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
         let mut leaves = [(0u32, 0u32); LANES];
         let mut found = 0;
         let flush_at = flush_at.clamp(1, LANES);
-        loop {
-            // Pairs of primitives on top go to the batch.
-            while let Some((a, b)) = stack.leaf_on_top() {
-                leaves[found] = (a, b);
+        while let Some(i) = stack.pop() {
+            let ((ra, rb), [ca, ea, cb, eb]) = (stack.pairs[i], stack.boxes[i]);
+            // A pair of primitives goes to the batch.
+            if ra.is_primitive() && rb.is_primitive() {
+                // `found` is below `flush_at <= LANES` here: the mask spares the check.
+                leaves[found & (LANES - 1)] = (ra.index(), rb.index());
                 found += 1;
                 if found >= flush_at {
                     stats.leaf_pairs += found as u64;
@@ -233,11 +235,8 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
                         return (flow, stats);
                     }
                 }
+                continue;
             }
-            let Some(i) = stack.inner_on_top() else {
-                break;
-            };
-            let ((ra, rb), [ca, ea, cb, eb]) = (stack.pairs[i], stack.boxes[i]);
             // One side is a primitive: up to four boxes below the other side's node
             // (`Below`), placed on the primitive's tree's axes, against its box.
             if ra.is_primitive() {
@@ -455,28 +454,11 @@ impl Pending {
         self.top = top + kept;
     }
 
-    /// Pops the top pair if it is a pair of primitives, as `(i, j)`.
+    /// Pops the top pair: its entry's index (read it before the next write).
     #[inline(always)]
-    fn leaf_on_top(&mut self) -> Option<(u32, u32)> {
-        let (ra, rb) = *self.pairs.get(self.top.checked_sub(1)?)?;
-        if !(ra.is_primitive() && rb.is_primitive()) {
-            return None;
-        }
-        self.top -= 1;
-        Some((ra.index(), rb.index()))
-    }
-
-    /// Pops the top pair if it has a node to split: its entry's index (read it before the
-    /// next write).
-    #[inline(always)]
-    fn inner_on_top(&mut self) -> Option<usize> {
-        let i = self.top.checked_sub(1)?;
-        let (ra, rb) = *self.pairs.get(i)?;
-        if ra.is_primitive() && rb.is_primitive() {
-            return None;
-        }
-        self.top = i;
-        Some(i)
+    fn pop(&mut self) -> Option<usize> {
+        self.top = self.top.checked_sub(1)?;
+        Some(self.top)
     }
 }
 
