@@ -19,7 +19,6 @@
 //! box is measured afterwards on every input point: the frames only choose its axes.
 
 use super::hull::{self, Plane};
-use super::rect::rectangle_frame;
 use super::sweep;
 use crate::num::pow2;
 use alloc::vec;
@@ -201,24 +200,24 @@ fn triangles(points: &[DVec3]) -> Option<([[u8; 3]; FACES], usize)> {
 /// volume over them, or `best` when none beats it.
 ///
 /// Each direction of the hull's triangles (coplanar ones merged) is a candidate normal `n`,
-/// whose frame is that of the minimum-area rectangle of the points projected along `n`.
-/// A box with axis `n` holds the hull, so its volume is at least the hull's extent along
-/// `n` times the area of the hull's shadow on the plane orthogonal to `n`,
-/// `¼·Σ_t |n·A_t|` over the triangles' doubled area vectors `A_t` (the shadow is covered
-/// twice). The first [`RECTANGLES`] normals in order of that bound get their rectangle,
-/// until the bound exceeds the best volume (with a relative margin of `10^-9` for its
-/// rounding), when no normal left can beat it.
+/// whose frame is that of the minimum-area rectangle of the points projected along `n`
+/// ([`shadow_rectangle`]). A box with axis `n` holds the hull, so its volume is at least
+/// the hull's extent along `n` times the area of the hull's shadow on the plane orthogonal
+/// to `n`, `¼·Σ_t |n·A_t|` over the triangles' doubled area vectors `A_t` (the shadow is
+/// covered twice). The first [`RECTANGLES`] normals in order of that bound get their
+/// rectangle, until the bound exceeds the best volume (with a relative margin of `10^-9`
+/// for its rounding), when no normal left can beat it.
 fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat3)> {
     let Some((faces, len)) = triangles(points) else {
         return best;
     };
+    let faces = &faces[..len];
     let at = |i: u8| points[usize::from(i)];
-    // The triangles' doubled area vectors, as columns padded with zero vectors, and the
-    // points as columns padded with the first point.
+    // The triangles' doubled area vectors, as columns padded with zero vectors.
     let mut area = [[0.0; FACES]; 3];
-    let mut normals = [(0.0, [0i64; 3], DVec3::ZERO); FACES];
+    let mut normals = [Normal::default(); FACES];
     let mut count = 0;
-    for (t, f) in faces[..len].iter().enumerate() {
+    for (t, f) in faces.iter().enumerate() {
         let [u, v, w] = f.map(at);
         let a = (v - u).cross(w - u);
         for (column, value) in area.iter_mut().zip(a.to_array()) {
@@ -227,45 +226,34 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
         let Some(unit) = a.try_normalize() else {
             continue;
         };
-        let key = hull::direction_key(unit);
-        normals[count] = (0.0, key, unit);
+        normals[count] = Normal {
+            key: hull::direction_key(unit),
+            unit,
+            ..Normal::default()
+        };
         count += 1;
     }
     // Coplanar triangles share a key: one normal each (any of theirs: they differ by
     // rounding).
     let normals = &mut normals[..count];
-    normals.sort_unstable_by_key(|normal| normal.1);
+    normals.sort_unstable_by_key(|normal| normal.key);
     let mut distinct = 0;
     for i in 0..normals.len() {
-        if i == 0 || normals[i].1 != normals[distinct - 1].1 {
+        if i == 0 || normals[i].key != normals[distinct - 1].key {
             normals[distinct] = normals[i];
             distinct += 1;
         }
     }
     let normals = &mut normals[..distinct];
-    // The hull's vertices, as points and as columns padded with the first.
+    // The hull's vertices as columns, padded with the first.
     let mut vertex = [false; POINTS];
-    for &i in faces[..len].iter().flatten() {
+    for &i in faces.iter().flatten() {
         vertex[usize::from(i)] = true;
     }
-    let mut corners = [DVec3::ZERO; POINTS];
-    let mut m = 0;
-    for (p, _) in points.iter().zip(vertex).filter(|(_, v)| *v) {
-        corners[m] = *p;
-        m += 1;
-    }
-    let corners = &corners[..m];
-    let mut column = [
-        [corners[0].x; COLUMN],
-        [corners[0].y; COLUMN],
-        [corners[0].z; COLUMN],
-    ];
-    for (j, p) in corners.iter().enumerate() {
-        (column[0][j], column[1][j], column[2][j]) = (p.x, p.y, p.z);
-    }
+    let (column, _) = columns(points, vertex);
     // Which triangle runs each edge `u → v`.
     let mut runs = [[NO_FACE; POINTS]; POINTS];
-    for (t, f) in faces[..len].iter().enumerate() {
+    for (t, f) in faces.iter().enumerate() {
         for k in 0..3 {
             runs[usize::from(f[k])][usize::from(f[(k + 1) % 3])] = t as u8;
         }
@@ -273,53 +261,71 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
     crate::simd::plain(
         #[inline(always)]
         || {
-            for (bound, _, n) in normals.iter_mut() {
-                *bound = extent(&column, *n) * shadow(&area, *n);
+            for normal in normals.iter_mut() {
+                normal.extent = extent(&column, normal.unit);
+                normal.bound = normal.extent * shadow(&area, normal.unit);
             }
         },
     );
-    normals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    normals.sort_unstable_by(|a, b| a.bound.total_cmp(&b.bound).then(a.key.cmp(&b.key)));
     let mut best = best;
-    for &(bound, _, n) in normals.iter().take(RECTANGLES) {
-        if best.is_some_and(|(volume, _)| bound > volume * (1.0 + 1e-9)) {
+    for normal in normals.iter().take(RECTANGLES) {
+        if best.is_some_and(|(volume, _)| normal.bound > volume * (1.0 + 1e-9)) {
             break;
         }
-        let on = outline(&faces[..len], &runs, &area, n);
-        let mut shadow = [DVec3::ZERO; POINTS];
-        let mut k = 0;
-        for (p, _) in points.iter().zip(on).filter(|(_, on)| *on) {
-            shadow[k] = *p;
-            k += 1;
-        }
-        let frame = rectangle_frame(n, &shadow[..k]);
-        let volume = volume_over(&frame, corners);
+        let n = normal.unit;
+        let Some((rectangle, side)) = shadow_rectangle(faces, &runs, &area, points, n) else {
+            continue;
+        };
+        let volume = normal.extent * rectangle;
         if best.is_none_or(|(least, _)| volume < least) {
-            best = Some((volume, frame));
+            let u = side.normalize();
+            best = Some((volume, DMat3::from_cols(u, n.cross(u), n)));
         }
     }
     best
 }
 
+/// A candidate normal of [`face_frame`]: its lower bound on the volume, its key, the unit
+/// vector and the hull's extent along it.
+#[derive(Clone, Copy, Default)]
+struct Normal {
+    bound: f64,
+    key: [i64; 3],
+    unit: DVec3,
+    extent: f64,
+}
+
 /// No triangle: an empty entry of the table of edges.
 const NO_FACE: u8 = u8::MAX;
 
-/// The hull's vertices on its outline seen along the unit direction `n`, as a mask over the
-/// points: among them, every vertex whose projection on the plane orthogonal to `n` is a
-/// corner of the hull's shadow there, as for [`hull::Solid::outline`], whose proof this
-/// follows. `runs[u][v]` is the triangle that runs the edge `u → v`.
+/// The minimum-area rectangle around the hull's shadow on the plane orthogonal to the unit
+/// `n`: its area and the direction of one of its sides (in that plane, not normalised);
+/// `None` when no side is found. `runs[u][v]` is the triangle that runs the edge `u → v`.
 ///
-/// A triangle faces `n` when `n·A > 2^-40·|A|₁` for its doubled area vector `A` (the `f64`
-/// value of `n·A` is within a few `u = 2^-53` of `|A|₁`, so a triangle that faces `n`
-/// really does), and is edge-on when `|n·A|` is at most that. The outline holds the first
-/// vertex of each edge that leaves a triangle facing `n` for one that does not (these
-/// edges bound the triangles facing `n`, so they form closed cycles, and each of their
-/// vertices starts one), and every vertex of an edge-on triangle.
-fn outline(
+/// **The outline.** A triangle faces `n` when `n·A > 2^-40·|A|₁` for its doubled area
+/// vector `A` (the `f64` value of `n·A` is within a few `u = 2^-53` of `|A|₁`, so a triangle
+/// that faces `n` really does), and is edge-on when `|n·A|` is at most that. The triangles
+/// facing `n` cover the shadow but for the slivers of edge-on ones; the edges that leave
+/// them for a triangle that does not face `n` bound them, and form closed cycles. So every
+/// side of the shadow's polygon lies along the projection of such an edge or of an edge of
+/// an edge-on triangle, and every corner is the projection of one of their vertices (the
+/// outline, as for [`hull::Solid::outline`]).
+///
+/// **The rectangle.** The least rectangle around a convex polygon has a side along one of
+/// its sides (Freeman & Shapira 1975). So each of those edges, projected on the plane, is a
+/// candidate side `d`; with `e = n × d`, its rectangle's area is the product of the ranges
+/// of `p·d` and `p·e` over the outline, over `|d|·|e|`. Extra candidates cost only time:
+/// each area is that of a rectangle that holds the shadow. The candidates are measured four
+/// at a time, in lanes; rounding can only make the chosen side slightly less than optimal,
+/// as the box is measured again on every point.
+fn shadow_rectangle(
     faces: &[[u8; 3]],
     runs: &[[u8; POINTS]; POINTS],
     area: &[[f64; FACES]; 3],
+    points: &[DVec3],
     n: DVec3,
-) -> [bool; POINTS] {
+) -> Option<(f64, DVec3)> {
     // 1 facing `n`, 0 edge-on, -1 facing away.
     let mut sides = [0i8; FACES];
     for (t, side) in sides.iter_mut().enumerate().take(faces.len()) {
@@ -328,14 +334,81 @@ fn outline(
         *side = i8::from(h > band) - i8::from(h < -band);
     }
     let mut on = [false; POINTS];
+    let mut edges = [[0u8; 2]; 3 * FACES];
+    let mut count = 0;
     for (f, side) in faces.iter().zip(sides) {
         for k in 0..3 {
-            let (u, v) = (usize::from(f[k]), usize::from(f[(k + 1) % 3]));
-            let across = sides.get(usize::from(runs[v][u])).copied();
-            on[u] |= side == 0 || (side == 1 && across != Some(1));
+            let (u, v) = (f[k], f[(k + 1) % 3]);
+            let across = sides.get(usize::from(runs[usize::from(v)][usize::from(u)]));
+            if side == 0 || (side == 1 && across != Some(&1)) {
+                on[usize::from(u)] = true;
+                edges[count] = [u, v];
+                count += 1;
+            }
         }
     }
-    on
+    let (outline, corners) = columns(points, on);
+    let at = |i: u8| points[usize::from(i)];
+    let least = crate::simd::plain(
+        #[inline(always)]
+        || {
+            let mut least = (f64::INFINITY, DVec3::ZERO);
+            for group in edges[..count].chunks(LANES) {
+                // The candidate sides `d` and `e = n × d`, a lane each, padded with the first.
+                let mut d = [[0.0; LANES]; 3];
+                let mut e = [[0.0; LANES]; 3];
+                for j in 0..LANES {
+                    let [u, v] = group[if j < group.len() { j } else { 0 }];
+                    let w = at(v) - at(u);
+                    let side = w - n * n.dot(w);
+                    let across = n.cross(side);
+                    for k in 0..3 {
+                        (d[k][j], e[k][j]) = (side[k], across[k]);
+                    }
+                }
+                let (mut d_lo, mut d_hi) = ([f64::INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
+                let (mut e_lo, mut e_hi) = (d_lo, d_hi);
+                let [xs, ys, zs] = outline.each_ref().map(|c| &c[..corners]);
+                for ((&x, &y), &z) in xs.iter().zip(ys).zip(zs) {
+                    for j in 0..LANES {
+                        let p = d[0][j] * x + d[1][j] * y + d[2][j] * z;
+                        let q = e[0][j] * x + e[1][j] * y + e[2][j] * z;
+                        d_lo[j] = if p < d_lo[j] { p } else { d_lo[j] };
+                        d_hi[j] = if p > d_hi[j] { p } else { d_hi[j] };
+                        e_lo[j] = if q < e_lo[j] { q } else { e_lo[j] };
+                        e_hi[j] = if q > e_hi[j] { q } else { e_hi[j] };
+                    }
+                }
+                for j in 0..LANES {
+                    let norms = (d[0][j] * d[0][j] + d[1][j] * d[1][j] + d[2][j] * d[2][j])
+                        * (e[0][j] * e[0][j] + e[1][j] * e[1][j] + e[2][j] * e[2][j]);
+                    let area = (d_hi[j] - d_lo[j]) * (e_hi[j] - e_lo[j]) / norms.sqrt();
+                    // A candidate of no length gives NaN, which never wins.
+                    if area < least.0 {
+                        least = (area, DVec3::new(d[0][j], d[1][j], d[2][j]));
+                    }
+                }
+            }
+            least
+        },
+    );
+    least.0.is_finite().then_some(least)
+}
+
+/// The points of the mask as coordinate columns, padded with the first of them, and how
+/// many there are.
+fn columns(points: &[DVec3], mask: [bool; POINTS]) -> ([[f64; COLUMN]; 3], usize) {
+    let mut column = [[0.0; COLUMN]; 3];
+    let mut m = 0;
+    for (p, _) in points.iter().zip(mask).filter(|(_, on)| *on) {
+        (column[0][m], column[1][m], column[2][m]) = (p.x, p.y, p.z);
+        m += 1;
+    }
+    for c in &mut column {
+        let first = c[0];
+        c[m..].fill(first);
+    }
+    (column, m)
 }
 
 /// Partial sums and extremes per lane group of [`extent`] and [`shadow`].
