@@ -154,21 +154,19 @@ fn to_f32(frame: DMat3) -> Mat3A {
 
 /// The boxes with the given axes holding `points`, certified.
 ///
-/// For an axis `a` (exact `f32`) and a point `p`, `p·a` in `f64` has exact products and two
-/// rounded sums ([`sweep::projection_ranges`]): it is within `γ(2)·S` of the exact value,
-/// `S = Σ_j |a_j|·max(|min_j|, |max_j|)` over the bounding box. So every exact projection
-/// lies in `[lo − γ(2)S, hi + γ(2)S]` for the computed extremes `lo`, `hi`. With the center
-/// `c` rounded to `f32` and `c·a` within `γ(2)·C` (`C = Σ_j |c_j a_j|`), every `|(p − c)·a|`
-/// is at most `max(hi − c·a, c·a − lo) + γ(2)(S + C)`; one more rounding for that
-/// difference, and the lemma's `Bounded::upper` with `scale = S + C` is a certified
-/// half-extent.
+/// For an axis `a` (exact `f32`), [`sweep::projection_ranges`] gives a range `[lo, hi]` such
+/// that every exact projection `p·a` lies in `[lo − γ(2)S, hi + γ(2)S]`, with
+/// `S = Σ_j |a_j|·max(|min_j|, |max_j|)` over the bounding box. With the center `c` rounded
+/// to `f32` and `c·a` within `γ(2)·C` (`C = Σ_j |c_j a_j|`), every `|(p − c)·a|` is at most
+/// `max(hi − c·a, c·a − lo) + γ(2)(S + C)`; one more rounding for that difference, and the
+/// lemma's `Bounded::upper` with `scale = S + C` is a certified half-extent.
 fn fit_axes<const N: usize>(
     points: &[Vec3],
     bounds: &Aabb3,
     rotations: [Mat3A; N],
     center: Center,
 ) -> [Result<Obb3, FitError>; N] {
-    let ranges = sweep::projection_ranges(points, rotations);
+    let ranges = sweep::projection_ranges(points, bounds, rotations);
     core::array::from_fn(|r| {
         let (lo, hi) = ranges[r];
         certified_box(rotations[r], lo, hi, bounds, center)

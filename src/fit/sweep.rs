@@ -9,7 +9,8 @@
 //! - [`bounds`]: the bounding box and the finiteness check, in `f32`.
 //! - [`summary`]: the extremes on 13 sample directions in `f32`, the bounding box, the
 //!   finiteness check and the first two moments in `f64`, in one pass.
-//! - [`projection_ranges`]: a box's projection ranges in `f64`, one pass per box.
+//! - [`projection_ranges`]: a box's projection ranges, certified, in `f32` (or `f64` for
+//!   points toward `±f32::MAX`), one pass per box.
 //!
 //! Two lessons of the measurements are kept in the code: a sweep keeps its state in locals
 //! that it returns (conditional writes through captured references do not vectorise), and
@@ -17,6 +18,7 @@
 //! stalls store forwarding).
 
 use crate::aabb::Aabb3;
+use crate::num::pow2;
 use crate::simd;
 use alloc::vec::Vec;
 use glam::{DMat3, DVec3, Mat3A, Vec3, Vec3A};
@@ -107,42 +109,118 @@ pub(crate) fn bounds(points: &[Vec3]) -> Result<Aabb3, usize> {
     ))
 }
 
-/// For each rotation, the least and greatest projections `a_k·p` of the points on its
-/// columns `a_k`, each evaluated in `f64` as `(a_x·x + a_y·y) + a_z·z`: the products of
-/// `f32` values are exact and the two sums round, so each is within `γ(2)·S` of the exact
-/// extreme (`u = 2^-53`, `S = Σ_j |a_j|·max_p |p_j|`). One pass per rotation: the state of
-/// one stays in registers.
+/// For each rotation, a range `[lo, hi]` such that every exact projection `a_k·p` of the
+/// points on its columns `a_k` lies in `[lo − γ(2)·S, hi + γ(2)·S]`, where
+/// `S = Σ_j |a_j|·reach_j` and `reach` holds the largest magnitudes of the bounding box
+/// `bounds`. One pass per rotation: the state of one stays in registers.
+///
+/// **In `f32` lanes**, twice as wide as `f64` ones, when `S <= 2^100`, about the center `o`
+/// of `bounds` (rounded to `f32`): each `a·(p − o)` is evaluated as
+/// `(a_x·(x − o_x) + a_y·(y − o_y)) + a_z·(z − o_z)`, three differences, three products and
+/// two sums rounded in `f32`, within `γ₃₂(5)·T + 3·2^-150` of exact, where
+/// `T = Σ_j |a_j|·r_j` and `r_j = max |p_j − o_j|` over the box (`γ₃₂(5) = 5·2^-24/(1 −
+/// 5·2^-24) < 2^-21.6`; `2^-150` bounds the error of a product that underflows; a difference
+/// that underflows is exact). No value can overflow, as each is at most about `S`. So the
+/// error is relative to the points' spread, not to their distance from the origin. The
+/// extremes are shifted by `a·o`, which `f64` evaluates within `γ(2)·S` (the allowance
+/// above), and moved out by `2^-21·T + 2^-147`, each sum rounded outward (`next_down`,
+/// `next_up` of the rounded sum).
+///
+/// **In `f64` lanes** otherwise: the products of `f32` values are exact and the two sums
+/// round, so each projection is within `γ(2)·S` of the computed extremes.
 pub(crate) fn projection_ranges<const N: usize>(
     points: &[Vec3],
+    bounds: &Aabb3,
     rotations: [Mat3A; N],
 ) -> [(DVec3, DVec3); N] {
-    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    let (min, max) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+    let reach = min.abs().max(max.abs());
+    let o = (0.5 * (min + max)).as_vec3();
+    let r = (max - o.as_dvec3()).max(o.as_dvec3() - min);
     rotations.map(|rotation| {
-        let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3().to_array());
-        let (lo, hi) = simd::plain(
-            #[inline(always)]
-            || {
-                let mut lo = [[f64::INFINITY; WIDTH]; 3];
-                let mut hi = [[f64::NEG_INFINITY; WIDTH]; 3];
-                // Padding with a point of the set changes no extreme.
-                let (full, tail, _) = groups(points, pad);
-                for group in full.chain([&tail]) {
-                    let [x, y, z] = columns_f64(group);
-                    for k in 0..3 {
-                        for j in 0..WIDTH {
-                            let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
-                            lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
-                            hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
-                        }
+        let axes = [0, 1, 2].map(|k| rotation.col(k).as_dvec3());
+        let scale = axes.map(|a| a.abs().dot(reach));
+        if !scale.iter().all(|&s| s <= pow2(100)) {
+            return ranges_f64(points, rotation);
+        }
+        let (lo, hi) = ranges_f32(points, o, rotation);
+        let pad = |k: usize| pow2(-21) * axes[k].abs().dot(r) + pow2(-147);
+        let shift = |k: usize| axes[k].dot(o.as_dvec3());
+        let ends = |k: usize| {
+            let low = (f64::from(lo[k]) + shift(k)).next_down();
+            let high = (f64::from(hi[k]) + shift(k)).next_up();
+            ((low - pad(k)).next_down(), (high + pad(k)).next_up())
+        };
+        let [x, y, z] = [0, 1, 2].map(ends);
+        (DVec3::new(x.0, y.0, z.0), DVec3::new(x.1, y.1, z.1))
+    })
+}
+
+/// The least and greatest projections `a·(p − o)` of the points on the columns of
+/// `rotation`, in `f32` (see [`projection_ranges`]).
+fn ranges_f32(points: &[Vec3], o: Vec3, rotation: Mat3A) -> ([f32; 3], [f32; 3]) {
+    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    let a = [0, 1, 2].map(|k| rotation.col(k).to_array());
+    let o = o.to_array();
+    let (lo, hi) = simd::plain(
+        #[inline(always)]
+        || {
+            let mut lo = [[f32::INFINITY; WIDTH]; 3];
+            let mut hi = [[f32::NEG_INFINITY; WIDTH]; 3];
+            // Padding with a point of the set changes no extreme.
+            let (full, tail, _) = groups(points, pad);
+            for group in full.chain([&tail]) {
+                let mut c = columns(group);
+                for (column, o) in c.iter_mut().zip(o) {
+                    for x in column {
+                        *x -= o;
                     }
                 }
-                (lo, hi)
-            },
-        );
-        let least = lo.map(|l| l.iter().copied().fold(f64::INFINITY, f64::min));
-        let greatest = hi.map(|h| h.iter().copied().fold(f64::NEG_INFINITY, f64::max));
-        (DVec3::from_array(least), DVec3::from_array(greatest))
-    })
+                let [x, y, z] = c;
+                for k in 0..3 {
+                    for j in 0..WIDTH {
+                        let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
+                        lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
+                        hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
+                    }
+                }
+            }
+            (lo, hi)
+        },
+    );
+    let least = lo.map(|l| l.iter().fold(f32::INFINITY, |a, &b| a.min(b)));
+    let greatest = hi.map(|h| h.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b)));
+    (least, greatest)
+}
+
+/// The least and greatest projections of the points on the columns of `rotation`, in `f64`
+/// (see [`projection_ranges`]).
+fn ranges_f64(points: &[Vec3], rotation: Mat3A) -> (DVec3, DVec3) {
+    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3().to_array());
+    let (lo, hi) = simd::plain(
+        #[inline(always)]
+        || {
+            let mut lo = [[f64::INFINITY; WIDTH]; 3];
+            let mut hi = [[f64::NEG_INFINITY; WIDTH]; 3];
+            // Padding with a point of the set changes no extreme.
+            let (full, tail, _) = groups(points, pad);
+            for group in full.chain([&tail]) {
+                let [x, y, z] = columns_f64(group);
+                for k in 0..3 {
+                    for j in 0..WIDTH {
+                        let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
+                        lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
+                        hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
+                    }
+                }
+            }
+            (lo, hi)
+        },
+    );
+    let least = lo.map(|l| l.iter().copied().fold(f64::INFINITY, f64::min));
+    let greatest = hi.map(|h| h.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+    (DVec3::from_array(least), DVec3::from_array(greatest))
 }
 
 /// Groups per chunk of [`summary`].
