@@ -473,6 +473,85 @@ mod tests {
         Vec3::new(0.0, 1.0, -1.0),
     ];
 
+    /// The sign of the exact sum of `f64` terms: a nonoverlapping expansion grown by TwoSum
+    /// (Shewchuk 1997), whose largest nonzero component has the sign of the sum.
+    fn exact_sign(terms: &[f64]) -> f64 {
+        let mut expansion: Vec<f64> = Vec::new();
+        for &t in terms {
+            let mut carry = t;
+            let mut grown = Vec::new();
+            for &e in &expansion {
+                let (sum, error) = crate::num::two_sum(carry, e);
+                if error != 0.0 {
+                    grown.push(error);
+                }
+                carry = sum;
+            }
+            grown.push(carry);
+            expansion = grown;
+        }
+        expansion
+            .iter()
+            .rev()
+            .find(|&&e| e != 0.0)
+            .map_or(0.0, |e| e.signum())
+    }
+
+    /// The `f32` sweep's range holds every exact projection (`a_j·p_j` is exact in `f64`;
+    /// the sign of `a·p − lo` is taken exactly), and its pad scales with the points'
+    /// spread, not their distance from the origin: far from it, near underflow, and for
+    /// a single point.
+    #[test]
+    fn projection_ranges_hold_every_exact_projection_within_the_spread() {
+        let mut random = crate::num::uniform(0x5eed_f00d);
+        for (offset, spread) in [
+            (0.0, 1.0),
+            (1.0e4, 1.0),
+            (-3.0e6, 0.01),
+            (1.0e-36, 1.0e-37),
+            (7.0e3, 0.0),
+        ] {
+            let points: Vec<Vec3> = (0..CHUNK * WIDTH + 5)
+                .map(|_| {
+                    Vec3::new(
+                        (offset + spread * random()) as f32,
+                        (offset * 0.5 + spread * random()) as f32,
+                        (-offset + spread * random()) as f32,
+                    )
+                })
+                .collect();
+            let bounds = bounds(&points).expect("finite");
+            let axis = glam::Vec3::new(random() as f32, random() as f32, 0.5).normalize();
+            let rotation = Mat3A::from_quat(glam::Quat::from_axis_angle(axis, 0.7));
+            let [(lo, hi)] = projection_ranges(&points, &bounds, [rotation]);
+            for k in 0..3 {
+                let a = rotation.col(k).as_dvec3();
+                let (mut least, mut greatest) = (f64::INFINITY, f64::NEG_INFINITY);
+                for p in &points {
+                    let terms = (a * p.as_dvec3()).to_array();
+                    let [x, y, z] = terms;
+                    assert!(exact_sign(&[x, y, z, -lo[k]]) >= 0.0, "{offset} {spread}");
+                    assert!(exact_sign(&[x, y, z, -hi[k]]) <= 0.0, "{offset} {spread}");
+                    let q = (x + y) + z;
+                    (least, greatest) = (least.min(q), greatest.max(q));
+                }
+                // The pad is a few millionths of the spread (and of `f64`'s rounding of a
+                // value near the offset), not of the offset.
+                let slack = 1e-5 * spread + 1e-15 * offset.abs() + 1e-40;
+                assert!(
+                    least - lo[k] <= slack,
+                    "{offset} {spread}: {}",
+                    least - lo[k]
+                );
+                assert!(
+                    hi[k] - greatest <= slack,
+                    "{offset} {spread}: {}",
+                    hi[k] - greatest
+                );
+            }
+        }
+    }
+
     /// The signed sums are the dot products with the sample directions, and the extremal
     /// points are the first points of least and greatest dot product, as a plain loop finds
     /// them (ties included: the points repeat, and the tail is longer than a group).
