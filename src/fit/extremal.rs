@@ -20,7 +20,7 @@
 
 use super::hull::{self, Plane};
 use super::sweep;
-use crate::num::pow2;
+use crate::num::{pow2, sqrt};
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::{DMat3, DVec3};
@@ -382,7 +382,7 @@ fn shadow_rectangle(
                 for j in 0..LANES {
                     let norms = (d[0][j] * d[0][j] + d[1][j] * d[1][j] + d[2][j] * d[2][j])
                         * (e[0][j] * e[0][j] + e[1][j] * e[1][j] + e[2][j] * e[2][j]);
-                    let area = (d_hi[j] - d_lo[j]) * (e_hi[j] - e_lo[j]) / norms.sqrt();
+                    let area = (d_hi[j] - d_lo[j]) * (e_hi[j] - e_lo[j]) / sqrt(norms);
                     // A candidate of no length gives NaN, which never wins.
                     if area < least.0 {
                         least = (area, DVec3::new(d[0][j], d[1][j], d[2][j]));
