@@ -159,68 +159,71 @@ pub(crate) fn projection_ranges<const N: usize>(
 /// The least and greatest projections `a·(p − o)` of the points on the columns of
 /// `rotation`, in `f32` (see [`projection_ranges`]).
 fn ranges_f32(points: &[Vec3], o: Vec3, rotation: Mat3A) -> ([f32; 3], [f32; 3]) {
-    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
     let a = [0, 1, 2].map(|k| rotation.col(k).to_array());
     let o = o.to_array();
-    let (lo, hi) = simd::plain(
-        #[inline(always)]
-        || {
-            let mut lo = [[f32::INFINITY; WIDTH]; 3];
-            let mut hi = [[f32::NEG_INFINITY; WIDTH]; 3];
-            // Padding with a point of the set changes no extreme.
-            let (full, tail, _) = groups(points, pad);
-            for group in full.chain([&tail]) {
-                let mut c = columns(group);
-                for (column, o) in c.iter_mut().zip(o) {
-                    for x in column {
-                        *x -= o;
-                    }
-                }
-                let [x, y, z] = c;
-                for k in 0..3 {
-                    for j in 0..WIDTH {
-                        let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
-                        lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
-                        hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
-                    }
-                }
+    let about_o = |group: &[Vec3; WIDTH]| {
+        let mut c = columns(group);
+        for (column, o) in c.iter_mut().zip(o) {
+            for x in column {
+                *x -= o;
             }
-            (lo, hi)
-        },
-    );
-    let least = lo.map(|l| l.iter().fold(f32::INFINITY, |a, &b| a.min(b)));
-    let greatest = hi.map(|h| h.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b)));
-    (least, greatest)
+        }
+        c
+    };
+    simd::plain(
+        #[inline(always)]
+        || extremes_on_axes(points, a, about_o, [f32::INFINITY, f32::NEG_INFINITY]),
+    )
 }
 
 /// The least and greatest projections of the points on the columns of `rotation`, in `f64`
 /// (see [`projection_ranges`]).
 fn ranges_f64(points: &[Vec3], rotation: Mat3A) -> (DVec3, DVec3) {
-    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
     let a = [0, 1, 2].map(|k| rotation.col(k).as_dvec3().to_array());
     let (lo, hi) = simd::plain(
         #[inline(always)]
-        || {
-            let mut lo = [[f64::INFINITY; WIDTH]; 3];
-            let mut hi = [[f64::NEG_INFINITY; WIDTH]; 3];
-            // Padding with a point of the set changes no extreme.
-            let (full, tail, _) = groups(points, pad);
-            for group in full.chain([&tail]) {
-                let [x, y, z] = columns_f64(group);
-                for k in 0..3 {
-                    for j in 0..WIDTH {
-                        let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
-                        lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
-                        hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
-                    }
-                }
-            }
-            (lo, hi)
-        },
+        || extremes_on_axes(points, a, columns_f64, [f64::INFINITY, f64::NEG_INFINITY]),
     );
-    let least = lo.map(|l| l.iter().copied().fold(f64::INFINITY, f64::min));
-    let greatest = hi.map(|h| h.iter().copied().fold(f64::NEG_INFINITY, f64::max));
-    (DVec3::from_array(least), DVec3::from_array(greatest))
+    (DVec3::from_array(lo), DVec3::from_array(hi))
+}
+
+/// The least and greatest `(a_x·x + a_y·y) + a_z·z` over the points, for each of the three
+/// axes `a`, in lanes of `T` from the groups' columns (`columns` of each group); `infinity`
+/// is `[+∞, −∞]` in `T`. Plain array code, for the backend's wrapper.
+#[inline(always)]
+fn extremes_on_axes<T>(
+    points: &[Vec3],
+    a: [[T; 3]; 3],
+    columns: impl Fn(&[Vec3; WIDTH]) -> [[T; WIDTH]; 3],
+    [positive, negative]: [T; 2],
+) -> ([T; 3], [T; 3])
+where
+    T: Copy + PartialOrd + core::ops::Add<Output = T> + core::ops::Mul<Output = T>,
+{
+    let mut lo = [[positive; WIDTH]; 3];
+    let mut hi = [[negative; WIDTH]; 3];
+    // Padding with a point of the set changes no extreme.
+    let pad = points.first().copied().unwrap_or(Vec3::ZERO);
+    let (full, tail, _) = groups(points, pad);
+    for group in full.chain([&tail]) {
+        let [x, y, z] = columns(group);
+        for k in 0..3 {
+            for j in 0..WIDTH {
+                let q = a[k][0] * x[j] + a[k][1] * y[j] + a[k][2] * z[j];
+                lo[k][j] = if q < lo[k][j] { q } else { lo[k][j] };
+                hi[k][j] = if q > hi[k][j] { q } else { hi[k][j] };
+            }
+        }
+    }
+    let least = lo.map(|l| {
+        l.into_iter()
+            .fold(positive, |a, b| if b < a { b } else { a })
+    });
+    let greatest = hi.map(|h| {
+        h.into_iter()
+            .fold(negative, |a, b| if b > a { b } else { a })
+    });
+    (least, greatest)
 }
 
 /// Groups per chunk of [`summary`].
