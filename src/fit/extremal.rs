@@ -19,8 +19,9 @@
 //! box is measured afterwards on every input point: the frames only choose its axes.
 
 use super::hull::{self, Plane};
+use super::rect;
 use super::sweep;
-use crate::num::{pow2, sqrt};
+use crate::num::pow2;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::{DMat3, DVec3};
@@ -279,8 +280,7 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
         };
         let volume = normal.extent * rectangle;
         if best.is_none_or(|(least, _)| volume < least) {
-            let u = side.normalize();
-            best = Some((volume, DMat3::from_cols(u, n.cross(u), n)));
+            best = Some((volume, rect::frame(n, side.normalize())));
         }
     }
     best
@@ -310,15 +310,8 @@ const NO_FACE: u8 = u8::MAX;
 /// them for a triangle that does not face `n` bound them, and form closed cycles. So every
 /// side of the shadow's polygon lies along the projection of such an edge or of an edge of
 /// an edge-on triangle, and every corner is the projection of one of their vertices (the
-/// outline, as for [`hull::Solid::outline`]).
-///
-/// **The rectangle.** The least rectangle around a convex polygon has a side along one of
-/// its sides (Freeman & Shapira 1975). So each of those edges, projected on the plane, is a
-/// candidate side `d`; with `e = n × d`, its rectangle's area is the product of the ranges
-/// of `p·d` and `p·e` over the outline, over `|d|·|e|`. Extra candidates cost only time:
-/// each area is that of a rectangle that holds the shadow. The candidates are measured four
-/// at a time, in lanes; rounding can only make the chosen side slightly less than optimal,
-/// as the box is measured again on every point.
+/// outline, as for [`hull::Solid::outline`]). Those edges and vertices go to
+/// [`rect::least_rectangle`].
 fn shadow_rectangle(
     faces: &[[u8; 3]],
     runs: &[[u8; POINTS]; POINTS],
@@ -338,61 +331,22 @@ fn shadow_rectangle(
     let mut count = 0;
     for (f, side) in faces.iter().zip(sides) {
         for k in 0..3 {
-            let (u, v) = (f[k], f[(k + 1) % 3]);
-            let across = sides.get(usize::from(runs[usize::from(v)][usize::from(u)]));
+            let (u, v) = (usize::from(f[k]), usize::from(f[(k + 1) % 3]));
+            let across = sides.get(usize::from(runs[v][u]));
             if side == 0 || (side == 1 && across != Some(&1)) {
-                on[usize::from(u)] = true;
-                edges[count] = [u, v];
+                on[u] = true;
+                edges[count] = [f[k], f[(k + 1) % 3]];
                 count += 1;
             }
         }
     }
     let (outline, corners) = columns(points, on);
-    let at = |i: u8| points[usize::from(i)];
-    let least = crate::simd::plain(
-        #[inline(always)]
-        || {
-            let mut least = (f64::INFINITY, DVec3::ZERO);
-            for group in edges[..count].chunks(LANES) {
-                // The candidate sides `d` and `e = n × d`, a lane each, padded with the first.
-                let mut d = [[0.0; LANES]; 3];
-                let mut e = [[0.0; LANES]; 3];
-                for j in 0..LANES {
-                    let [u, v] = group[if j < group.len() { j } else { 0 }];
-                    let w = at(v) - at(u);
-                    let side = w - n * n.dot(w);
-                    let across = n.cross(side);
-                    for k in 0..3 {
-                        (d[k][j], e[k][j]) = (side[k], across[k]);
-                    }
-                }
-                let (mut d_lo, mut d_hi) = ([f64::INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
-                let (mut e_lo, mut e_hi) = (d_lo, d_hi);
-                let [xs, ys, zs] = outline.each_ref().map(|c| &c[..corners]);
-                for ((&x, &y), &z) in xs.iter().zip(ys).zip(zs) {
-                    for j in 0..LANES {
-                        let p = d[0][j] * x + d[1][j] * y + d[2][j] * z;
-                        let q = e[0][j] * x + e[1][j] * y + e[2][j] * z;
-                        d_lo[j] = if p < d_lo[j] { p } else { d_lo[j] };
-                        d_hi[j] = if p > d_hi[j] { p } else { d_hi[j] };
-                        e_lo[j] = if q < e_lo[j] { q } else { e_lo[j] };
-                        e_hi[j] = if q > e_hi[j] { q } else { e_hi[j] };
-                    }
-                }
-                for j in 0..LANES {
-                    let norms = (d[0][j] * d[0][j] + d[1][j] * d[1][j] + d[2][j] * d[2][j])
-                        * (e[0][j] * e[0][j] + e[1][j] * e[1][j] + e[2][j] * e[2][j]);
-                    let area = (d_hi[j] - d_lo[j]) * (e_hi[j] - e_lo[j]) / sqrt(norms);
-                    // A candidate of no length gives NaN, which never wins.
-                    if area < least.0 {
-                        least = (area, DVec3::new(d[0][j], d[1][j], d[2][j]));
-                    }
-                }
-            }
-            least
-        },
-    );
-    least.0.is_finite().then_some(least)
+    rect::least_rectangle(
+        n,
+        points,
+        &edges[..count],
+        outline.each_ref().map(|c| &c[..corners]),
+    )
 }
 
 /// The points of the mask as coordinate columns, padded with the first of them, and how

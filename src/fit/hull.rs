@@ -329,17 +329,18 @@ impl Solid {
         (hi - lo).max(0.0)
     }
 
-    /// The vertices on the hull's outline seen along the unit direction `n`, some more than
-    /// once: among them, every vertex whose projection on the plane orthogonal to `n` is a
-    /// corner of the hull's shadow there. So the shadow's convex hull is that of the
-    /// outline's projection, found from a few vertices rather than all of them.
+    /// The edges of the hull's outline seen along the unit direction `n`, as vertex pairs:
+    /// the edges that leave a triangle facing `n` for one that does not, run as in the
+    /// triangle facing `n` (they bound those triangles, so they form closed cycles), and the
+    /// three edges of every edge-on triangle. Their first vertices are the *outline*, some
+    /// more than once: among them, every vertex whose projection on the plane orthogonal to
+    /// `n` is a corner of the hull's shadow there, and every side of the shadow lies along
+    /// the projection of one of the edges. So the shadow's least rectangle is found from a
+    /// few vertices and edges rather than all of them ([`super::rect::least_rectangle`]).
     ///
     /// A triangle faces `n` when `n·A > 2^-40·s` for its area vector `A` and its scale `s`
     /// (the `f64` value of `n·A` is within a few `u = 2^-53` of `s`, so a triangle that faces
-    /// `n` really does), and is *edge-on* when `|n·A| <= 2^-40·s`. The outline holds the first
-    /// vertex of each edge that leaves a triangle facing `n` for one that does not (these
-    /// edges bound the triangles facing `n`, so they form closed cycles, and each of their
-    /// vertices starts one), and every vertex of an edge-on triangle.
+    /// `n` really does), and is *edge-on* when `|n·A| <= 2^-40·s`.
     ///
     /// *Proof* that it holds each corner vertex `v`: some direction `d ⟂ n` is maximised at
     /// `v`, so `d` is in the cone spanned by the normals of the triangles around `v`. They
@@ -355,7 +356,7 @@ impl Solid {
     /// has its edges in cells, so the outline is the one a test of every edge gives (a unit
     /// test checks it), at the cost of a few cells' edges: those whose normals lie near the
     /// great circle orthogonal to `n`.
-    pub fn outline(&self, n: DVec3) -> Vec<usize> {
+    pub fn outline(&self, n: DVec3) -> Vec<[usize; 2]> {
         // 1 facing `n`, 0 edge-on, -1 facing away.
         let side = |area: DVec3, band: f64| {
             let h = area.dot(n);
@@ -375,14 +376,17 @@ impl Solid {
             }
             for edge in edges {
                 let sides = [0, 1].map(|k| side(edge.areas[k], edge.bands[k]));
-                if (sides[0] == 1) != (sides[1] == 1) {
-                    outline.push(edge.tails[usize::from(sides[1] == 1)]);
+                let [u, v] = edge.tails;
+                if sides[0] == 1 && sides[1] != 1 {
+                    outline.push([u, v]);
+                } else if sides[1] == 1 && sides[0] != 1 {
+                    outline.push([v, u]);
                 }
                 // An edge-on triangle, once: from its first edge.
                 for ((side, face), tail) in sides.into_iter().zip(edge.faces).zip(edge.tails) {
-                    let triangle = self.triangles[face];
-                    if side == 0 && tail == triangle[0] {
-                        outline.extend(triangle);
+                    let [a, b, c] = self.triangles[face];
+                    if side == 0 && tail == a {
+                        outline.extend([[a, b], [b, c], [c, a]]);
                     }
                 }
             }
@@ -440,13 +444,16 @@ pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
 /// Four affinely independent points to start from (the first point, the farthest from
 /// it, the farthest from their line, the farthest from their plane), or the hull of a set
 /// that has none.
+///
+/// Each pass computes one key per point ([`last_greatest`]). The last one ranks the points by
+/// the `f64` value of `n·(p − p₀)`, which only chooses among them: the chosen point is
+/// accepted when the exact `orient3d` puts it off the plane, and only when it does not
+/// (a set flat to within rounding) are the points scanned with the exact predicate.
 pub(crate) fn tetrahedron(points: &[DVec3]) -> Result<[usize; 4], Hull> {
     let Some(&p0) = points.first() else {
         return Err(Hull::Point);
     };
-    let farthest = |key: &dyn Fn(DVec3) -> f64| {
-        (0..points.len()).max_by(|&i, &j| key(points[i]).total_cmp(&key(points[j])))
-    };
+    let farthest = |key: &dyn Fn(DVec3) -> f64| last_greatest(0..points.len(), |i| key(points[i]));
     let i1 = farthest(&|p| p.distance_squared(p0)).unwrap_or(0);
     let p1 = points[i1];
     if p1 == p0 {
@@ -467,10 +474,30 @@ pub(crate) fn tetrahedron(points: &[DVec3]) -> Result<[usize; 4], Hull> {
         return Err(Hull::Segment(axis));
     };
     let volume = |p: DVec3| orient3d(coord(p0), coord(p1), coord(p2), coord(p));
-    let Some(i3) = farthest(&|p| volume(p).abs()).filter(|&i| volume(points[i]) != 0.0) else {
-        return Err(Hull::Planar(normal));
-    };
-    Ok([0, i1, i2, i3])
+    let off_plane = |i: usize| volume(points[i]) != 0.0;
+    let i3 = farthest(&|p| (p - p0).dot(normal).abs())
+        .filter(|&i| off_plane(i))
+        .or_else(|| (0..points.len()).find(|&i| off_plane(i)));
+    match i3 {
+        Some(i3) => Ok([0, i1, i2, i3]),
+        None => Err(Hull::Planar(normal)),
+    }
+}
+
+/// The index of the greatest `key`, the last among equals (`None` for no indices or NaN
+/// keys only): one key per index, where `max_by` computes two per comparison.
+fn last_greatest(
+    indices: impl Iterator<Item = usize>,
+    key: impl Fn(usize) -> f64,
+) -> Option<usize> {
+    let mut best = (f64::NEG_INFINITY, None);
+    for i in indices {
+        let k = key(i);
+        if k >= best.0 {
+            best = (k, Some(i));
+        }
+    }
+    best.1
 }
 
 /// Sample directions for [`outside_extremal_hull`]: the coordinate axes, the cube
@@ -753,9 +780,7 @@ impl<'a> Quickhull<'a> {
     /// point that the face sees is a valid choice); the last of them on ties.
     fn eye(&self, face: usize) -> usize {
         let Plane { a, n, .. } = self.planes[face];
-        let height = |i: usize| (self.points[i] - a).dot(n);
-        self.outside(face)
-            .max_by(|&i, &j| height(i).total_cmp(&height(j)))
+        last_greatest(self.outside(face), |i| (self.points[i] - a).dot(n))
             .unwrap_or(self.first[face])
     }
 
@@ -980,15 +1005,25 @@ mod tests {
                     let h = hull.areas[t].dot(n);
                     i8::from(h > bands[t]) - i8::from(h < -bands[t])
                 };
-                let mut every: Vec<usize> = hull
+                let mut every: Vec<[usize; 2]> = hull
                     .edges
                     .iter()
                     .filter(|e| (side(e.faces[0]) == 1) != (side(e.faces[1]) == 1))
-                    .map(|e| e.tails[usize::from(side(e.faces[1]) == 1)])
+                    .map(|e| {
+                        let [u, v] = e.tails;
+                        if side(e.faces[0]) == 1 {
+                            [u, v]
+                        } else {
+                            [v, u]
+                        }
+                    })
                     .chain(
                         (0..hull.triangles.len())
                             .filter(|&t| side(t) == 0)
-                            .flat_map(|t| hull.triangles[t]),
+                            .flat_map(|t| {
+                                let [a, b, c] = hull.triangles[t];
+                                [[a, b], [b, c], [c, a]]
+                            }),
                     )
                     .collect();
                 let mut found = hull.outline(n);
@@ -1034,7 +1069,8 @@ mod tests {
                 }
                 let (e1, e2) = n.any_orthonormal_pair();
                 let flat = |p: DVec3| glam::DVec2::new(p.dot(e1), p.dot(e2));
-                let outline = hull.outline(n);
+                let edges = hull.outline(n);
+                let outline: Vec<usize> = edges.iter().map(|e| e[0]).collect();
                 if round {
                     // The point of it: a rim of the ball, not all of it.
                     let mut distinct = outline.clone();
@@ -1058,6 +1094,17 @@ mod tests {
                         );
                     }
                 }
+                // A side of the shadow's least rectangle lies along one of the edges.
+                let (_, least) = crate::fit::rect::min_area_rectangle(&mut shadow.clone());
+                let column = |k: usize| outline.iter().map(|&i| hull.vertices[i][k]).collect();
+                let [x, y, z]: [Vec<f64>; 3] = [column(0), column(1), column(2)];
+                let (area, _) =
+                    crate::fit::rect::least_rectangle(n, &hull.vertices, &edges, [&x, &y, &z])
+                        .expect("a rectangle");
+                assert!(
+                    (area - least).abs() <= 1e-9 * least,
+                    "{area} against {least} along {n}"
+                );
             }
         }
     }

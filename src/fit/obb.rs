@@ -9,7 +9,7 @@ use alloc::vec::Vec;
 use super::eigen::principal_axes;
 use super::extremal::{self, frame_from};
 use super::hull::{Hull, Solid, convex_hull, direction_key};
-use super::rect::rectangle_frame;
+use super::rect::{self, rectangle_frame};
 use super::search::compass_search;
 use super::sweep;
 use super::{Fit, FitError};
@@ -420,7 +420,6 @@ pub(crate) fn tight_frames(points: &[DVec3]) -> TightFrames {
 /// Normals are taken in order of that bound, and once it exceeds the `keep`-th best
 /// volume found (with a relative margin of `10^-9` for its rounding), none left can enter.
 fn face_frames(hull: &Solid, normals: usize, keep: usize) -> Vec<(f64, DMat3)> {
-    let vertices = &hull.vertices;
     // Each normal's ends start the climbs of the next.
     let mut ends = [0; 2];
     let mut bounded: Vec<(f64, DVec3)> = face_normals(hull, normals)
@@ -435,14 +434,34 @@ fn face_frames(hull: &Solid, normals: usize, keep: usize) -> Vec<(f64, DMat3)> {
         if best.len() == keep && best.last().is_some_and(|b| bound > b.0 * (1.0 + 1e-9)) {
             break;
         }
-        let outline: Vec<DVec3> = hull.outline(n).into_iter().map(|i| vertices[i]).collect();
-        let frame = rectangle_frame(n, &outline);
+        let frame = outline_frame(hull, n);
         let volume = hull.extents(&frame, &mut from).element_product();
         let at = best.partition_point(|b| b.0 <= volume);
         best.insert(at, (volume, frame));
         best.truncate(keep);
     }
     best
+}
+
+/// Outlines of at most this many edges get their rectangle from their edges, in lanes
+/// ([`rect::least_rectangle`], `O(E·V)`); longer ones from the calipers around their
+/// projected hull ([`rectangle_frame`], `O(V log V)`).
+const LANE_RECTANGLE: usize = 96;
+
+/// The frame of the minimum-area rectangle around the hull's shadow along the unit `n`,
+/// from its outline ([`Solid::outline`]).
+fn outline_frame(hull: &Solid, n: DVec3) -> DMat3 {
+    let vertices = &hull.vertices;
+    let edges = hull.outline(n);
+    if edges.len() <= LANE_RECTANGLE {
+        let columns = [0, 1, 2].map(|k| edges.iter().map(|e| vertices[e[0]][k]).collect());
+        let [x, y, z]: [Vec<f64>; 3] = columns;
+        if let Some((_, side)) = rect::least_rectangle(n, vertices, &edges, [&x, &y, &z]) {
+            return rect::frame(n, side.normalize());
+        }
+    }
+    let outline: Vec<DVec3> = edges.iter().map(|e| vertices[e[0]]).collect();
+    rectangle_frame(n, &outline)
 }
 
 /// The unit normals of the hull faces, coplanar faces merged, largest area first, at most
