@@ -88,6 +88,10 @@ struct Cell {
 /// cells it cannot rule out.
 const CELL_EDGES: usize = 16;
 
+/// The room an outline starts with ([`Solid::outline`]): the rims of meshes of a few
+/// thousand vertices hold a few dozen edges.
+const OUTLINE_ROOM: usize = 128;
+
 /// A cell is ruled out when its range of `n·u` clears its `reach` by this much, far more
 /// than the rounding of `n·u` and of the triangles' own side tests (a few `2^-53`).
 const CELL_MARGIN: f64 = pow2(-30);
@@ -362,7 +366,8 @@ impl Solid {
             let h = area.dot(n);
             i8::from(h > band) - i8::from(h < -band)
         };
-        let mut outline = Vec::new();
+        // Room for a typical rim at once, rather than growing through five reallocations.
+        let mut outline = Vec::with_capacity(OUTLINE_ROOM);
         let mut start = 0;
         for cell in &self.cells {
             let edges = &self.edges[start..cell.end];
