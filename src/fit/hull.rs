@@ -389,9 +389,11 @@ impl Solid {
                 }
                 // An edge-on triangle, once: from its first edge.
                 for ((side, face), tail) in sides.into_iter().zip(edge.faces).zip(edge.tails) {
-                    let [a, b, c] = self.triangles[face];
-                    if side == 0 && tail == a {
-                        outline.extend([[a, b], [b, c], [c, a]]);
+                    if side == 0 {
+                        let [a, b, c] = self.triangles[face];
+                        if tail == a {
+                            outline.extend([[a, b], [b, c], [c, a]]);
+                        }
                     }
                 }
             }
