@@ -53,6 +53,9 @@ pub(crate) struct Solid {
     /// The area vectors' coordinate columns in lanes of [`LANES`] (the last padded with
     /// zeros), for [`Solid::shadow`].
     columns: [Vec<[f64; LANES]>; 3],
+    /// The vertices' coordinate columns in lanes of [`LANES`] (the last padded with the last
+    /// vertex), for [`Solid::scan`].
+    points: [Vec<[f64; LANES]>; 3],
 }
 
 /// An edge of a solid hull: its two triangles, and its first vertex as it runs in each
@@ -69,6 +72,13 @@ struct Edge {
 /// Hulls of at most this many vertices are measured by a scan of every vertex, not by
 /// climbs ([`Solid::extent`]): the hulls of small meshes (a box's 8 corners).
 const SCANNED: usize = 32;
+
+/// Hulls of at most this many vertices are measured along directions far from the last
+/// ones by a scan of every vertex in lanes ([`Solid::extents_afar`]): a climb across the
+/// hull takes tens of steps of a few neighbours each, with unpredictable branches, where the
+/// scan takes about two instructions a vertex. The two cost about the same instructions
+/// on the teapot's hull of 878 vertices.
+const FAR_SCANNED: usize = 1024;
 
 /// Triangles per lane group of [`Solid::shadow`].
 const LANES: usize = 4;
@@ -225,6 +235,12 @@ impl Solid {
                 .collect()
         };
         let columns = [0, 1, 2].map(|k| lanes(&|t| areas[t][k]));
+        let last = vertices.len() - 1;
+        let points = [0, 1, 2].map(|k| {
+            (0..vertices.len().div_ceil(LANES))
+                .map(|g| core::array::from_fn(|j| vertices[(g * LANES + j).min(last)][k]))
+                .collect()
+        });
         // `2^-40` times each triangle's scale `|b − a|₁·|c − a|₁`, which bounds the
         // rounding of its area vector ([`Solid::outline`]).
         let bands: Vec<f64> = scales.iter().map(|&s| pow2(-40) * s).collect();
@@ -253,6 +269,7 @@ impl Solid {
             starts,
             links,
             columns,
+            points,
         }
     }
 
@@ -297,6 +314,57 @@ impl Solid {
         }
     }
 
+    /// The extents `max − min` of the hull along each of `axes`, by a scan of every vertex
+    /// in lanes of [`LANES`] (the products and sums of `DVec3::dot`, in its order, so the
+    /// values are those of the climbs' last vertices).
+    pub fn scan<const N: usize>(&self, axes: [DVec3; N]) -> [f64; N] {
+        const { assert!(N <= 3) };
+        let [x, y, z] = &self.points;
+        // Room for three axes, of which the first `N` are used.
+        let (lo, hi) = crate::simd::plain(
+            #[inline(always)]
+            || {
+                let mut lo = [[f64::INFINITY; LANES]; 3];
+                let mut hi = [[f64::NEG_INFINITY; LANES]; 3];
+                for g in 0..x.len() {
+                    for (k, a) in axes.iter().enumerate() {
+                        for j in 0..LANES {
+                            let h = x[g][j] * a.x + y[g][j] * a.y + z[g][j] * a.z;
+                            lo[k][j] = if h < lo[k][j] { h } else { lo[k][j] };
+                            hi[k][j] = if h > hi[k][j] { h } else { hi[k][j] };
+                        }
+                    }
+                }
+                (lo, hi)
+            },
+        );
+        core::array::from_fn(|k| {
+            let low = lo[k].iter().copied().fold(f64::INFINITY, f64::min);
+            let high = hi[k].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (high - low).max(0.0)
+        })
+    }
+
+    /// The extents on the columns of `frame`, which may lie far from any frame measured
+    /// before: a scan of every vertex ([`Solid::scan`]) on hulls of at most [`FAR_SCANNED`]
+    /// vertices, else climbs from `from` ([`Solid::extents`]).
+    pub fn extents_afar(&self, frame: &DMat3, from: &mut [usize; 6]) -> DVec3 {
+        if self.vertices.len() <= FAR_SCANNED {
+            return DVec3::from_array(self.scan([frame.x_axis, frame.y_axis, frame.z_axis]));
+        }
+        self.extents(frame, from)
+    }
+
+    /// The extent along `axis`, which may lie far from any direction measured before, as
+    /// [`Solid::extents_afar`] measures it.
+    pub fn extent_afar(&self, axis: DVec3, from: &mut [usize; 2]) -> f64 {
+        if self.vertices.len() <= FAR_SCANNED {
+            let [extent] = self.scan([axis]);
+            return extent;
+        }
+        self.extent(axis, from)
+    }
+
     /// The extents `max − min` of the hull on the columns of `frame`, by six climbs
     /// ([`Solid::extreme`]) from the vertices in `from` (the lowest and highest on each
     /// column of a nearby frame), which are updated: a box's size near a known one in a few
@@ -319,13 +387,8 @@ impl Solid {
     /// as it is.
     pub fn extent(&self, axis: DVec3, from: &mut [usize; 2]) -> f64 {
         if self.vertices.len() <= SCANNED {
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for v in &self.vertices {
-                let h = v.dot(axis);
-                lo = if h < lo { h } else { lo };
-                hi = if h > hi { h } else { hi };
-            }
-            return (hi - lo).max(0.0);
+            let [extent] = self.scan([axis]);
+            return extent;
         }
         from[0] = self.extreme(-axis, from[0]);
         from[1] = self.extreme(axis, from[1]);
@@ -1074,6 +1137,14 @@ mod tests {
                 for from in [0, hull.vertices.len() / 2] {
                     assert_eq!(hull.vertices[hull.extreme(n, from)].dot(n), top);
                 }
+                // The scan in lanes gives the same extents, to the bit.
+                let extent = |d: DVec3| {
+                    let h = hull.vertices.iter().map(|v| v.dot(d));
+                    h.clone().fold(f64::MIN, f64::max) - h.fold(f64::MAX, f64::min)
+                };
+                assert_eq!(hull.scan([n]), [extent(n)]);
+                let frame = [n, n.any_orthonormal_vector(), DVec3::X];
+                assert_eq!(hull.scan(frame), frame.map(extent));
                 let (e1, e2) = n.any_orthonormal_pair();
                 let flat = |p: DVec3| glam::DVec2::new(p.dot(e1), p.dot(e2));
                 let edges = hull.outline(n);

@@ -424,7 +424,7 @@ fn face_frames(hull: &Solid, normals: usize, keep: usize) -> Vec<(f64, DMat3)> {
     let mut ends = [0; 2];
     let mut bounded: Vec<(f64, DVec3)> = face_normals(hull, normals)
         .into_iter()
-        .map(|n| (hull.extent(n, &mut ends) * hull.shadow(n), n))
+        .map(|n| (hull.extent_afar(n, &mut ends) * hull.shadow(n), n))
         .collect();
     bounded.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Vec<(f64, DMat3)> = Vec::with_capacity(keep + 1);
@@ -435,7 +435,7 @@ fn face_frames(hull: &Solid, normals: usize, keep: usize) -> Vec<(f64, DMat3)> {
             break;
         }
         let frame = outline_frame(hull, n);
-        let volume = hull.extents(&frame, &mut from).element_product();
+        let volume = hull.extents_afar(&frame, &mut from).element_product();
         let at = best.partition_point(|b| b.0 <= volume);
         best.insert(at, (volume, frame));
         best.truncate(keep);

@@ -6,6 +6,10 @@
 //! other extreme vertices and advance them monotonically, `O(m)` for `m` vertices. Rounding
 //! in `f64` can only make the chosen direction slightly less than optimal: the fits measure
 //! their extents again from every point.
+//!
+//! For a polytope's shadow, the same rectangle is also found without the 2D hull: from the
+//! edges of its outline as candidate sides, measured in lanes ([`least_rectangle`]), which
+//! costs less on the few dozen points of an outline.
 
 use crate::num::sqrt;
 use alloc::vec::Vec;
