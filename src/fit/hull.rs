@@ -593,11 +593,10 @@ const DIRECTIONS: [[f64; 3]; 13] = [
 /// which are not (a point inside the hull of others is no vertex of the hull of all). The
 /// `seed` points are always kept.
 ///
-/// The test is a floating-point filter that only ever drops a point it has proven inside:
-/// for a face `(a, b, c)` with `n = (b − a) × (c − a)` and a point `p`, the `f64` value of
-/// `n·(p − a)` is within a few `u = 2^-53` of `|b − a|₁·|c − a|₁·|p − a|₁` of the exact one,
-/// far below the pad `2^-40` times that; a point below every face by more than its pad lies
-/// strictly inside. Inputs too small to gain keep every point.
+/// The test is a floating-point filter that only ever drops a point it has proven inside,
+/// run in `f32` lanes ([`FilterPlane`]): a point below every face by more than its pad
+/// lies strictly inside. Inputs too small to gain keep every point, and so do those whose
+/// faces and spread could overflow or underflow `f32` (the filter only saves time).
 fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let all = || (0..points.len()).collect();
     if points.len() < 64 {
@@ -628,16 +627,21 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let Hull::Solid(solid) = inner.into_hull() else {
         return all();
     };
-    let faces: Vec<Plane> = solid
+    // Every `|p|₁` is at most `reach`: the extremes along the axes are among the subset.
+    let reach = (0..3)
+        .map(|k| subset.iter().map(|p| p[k].abs()).fold(0.0, f64::max))
+        .sum::<f64>();
+    let faces: Option<Vec<FilterPlane>> = solid
         .triangles
         .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| solid.vertices[i]);
-            Plane::new(a, b, c)
-        })
+        .map(|t| FilterPlane::new(t.map(|i| solid.vertices[i]), reach))
         .collect();
-    // The points in coordinate columns, each face tested on all of them in lanes.
-    let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).collect::<Vec<f64>>());
+    let Some(faces) = faces else {
+        return all();
+    };
+    // The points in coordinate columns (exact in `f32`), each face tested on all of them
+    // in lanes.
+    let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k] as f32).collect::<Vec<f32>>());
     let inside = crate::simd::plain(
         #[inline(always)]
         || {
@@ -677,19 +681,6 @@ impl Plane {
         }
     }
 
-    /// Clears `inside[i]` unless the point `(x[i], y[i], z[i])` lies below the plane by
-    /// more than the pad ([`Plane::side`] gives `Some(false)`): plain array code, for lanes.
-    #[inline(always)]
-    fn below(&self, x: &[f64], y: &[f64], z: &[f64], inside: &mut [bool]) {
-        let Self { a, n, pad } = *self;
-        for (i, inside) in inside.iter_mut().enumerate() {
-            let d = [x[i] - a.x, y[i] - a.y, z[i] - a.z];
-            let height = n.x * d[0] + n.y * d[1] + n.z * d[2];
-            let reach = pad * (d[0].abs() + d[1].abs() + d[2].abs());
-            *inside &= height < -reach;
-        }
-    }
-
     /// `Some(true)` when `p` lies strictly above the plane (on the side of `n`),
     /// `Some(false)` strictly below, `None` within the pad (undecided).
     #[inline]
@@ -703,6 +694,61 @@ impl Plane {
             Some(false)
         } else {
             None
+        }
+    }
+}
+
+/// A face's plane for [`outside_extremal_hull`]'s filter, in `f32`: a vertex `a` (the
+/// points are `f32` values, so it is exact), the normal `n = (b − a) × (c − a)` computed in
+/// `f64` and rounded to `f32`, and the pad factor `2^-20·|b − a|₁·|c − a|₁` rounded up.
+///
+/// **The bound.** With `D = p − a` exact and `H = ((b − a) × (c − a))·D` exact, each
+/// `|n_i| <= |b − a|₁·|c − a|₁`, so `S = |b − a|₁·|c − a|₁·|D|₁` bounds `Σ|n_i·D_i|`. The
+/// `f64` normal is within a few `2^-53` of `S/|D|₁` per component; rounding it to `f32`,
+/// the three differences `d = fl(p − a)`, the three products and the two sums add at most
+/// `γ₃₂(6) < 2^-21.4` of `S` and, where products underflow, `3·2^-150`. The computed height
+/// `h` is therefore within `2^-21·S + 2^-147` of `H`. The computed reach
+/// `pad·(|d₀| + |d₁| + |d₂|)` is at least `2^-20·S·(1 − 2^-21)` less `2^-147` (where it
+/// underflows), above `2^-21·S`; the filter drops a point only when
+/// `h < −(reach + 2^-140)`, which proves `H < 0`. The pad itself must be a normal `f32`:
+/// below `2^-120` the plane is refused.
+///
+/// **No overflow.** A plane is also refused (`None`) unless, with `R` a bound on every
+/// `|p|₁`, `2R < 2^120` and `pad·2R < 2^100`: then every difference, product, sum and
+/// reach stays inside `f32`'s range (`|D|₁ <= 2R`, `|n_i| <= 2^20·pad`).
+#[derive(Clone, Copy, Debug)]
+struct FilterPlane {
+    a: [f32; 3],
+    n: [f32; 3],
+    pad: f32,
+}
+
+impl FilterPlane {
+    fn new([a, b, c]: [DVec3; 3], reach: f64) -> Option<Self> {
+        let (ab, ac) = (b - a, c - a);
+        let n = ab.cross(ac);
+        // Rounding up by a relative `2^-20` covers the product's rounding and the
+        // conversion's.
+        let pad = pow2(-20) * ab.abs().element_sum() * ac.abs().element_sum() * (1.0 + pow2(-20));
+        let fits = pad >= pow2(-120) && 2.0 * reach < pow2(120) && pad * 2.0 * reach < pow2(100);
+        fits.then(|| Self {
+            a: a.to_array().map(|v| v as f32),
+            n: n.to_array().map(|v| v as f32),
+            pad: pad as f32 * (1.0 + pow2(-20) as f32),
+        })
+    }
+
+    /// Clears `inside[i]` unless the point `(x[i], y[i], z[i])` lies below the plane by
+    /// more than the pad: plain array code, for lanes.
+    #[inline(always)]
+    fn below(&self, x: &[f32], y: &[f32], z: &[f32], inside: &mut [bool]) {
+        let Self { a, n, pad } = *self;
+        let least = pow2(-140) as f32;
+        for (i, inside) in inside.iter_mut().enumerate() {
+            let d = [x[i] - a[0], y[i] - a[1], z[i] - a[2]];
+            let height = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+            let reach = pad * (d[0].abs() + d[1].abs() + d[2].abs());
+            *inside &= height < -(reach + least);
         }
     }
 }
@@ -1007,6 +1053,52 @@ mod tests {
     /// The filter drops no vertex: the hull of a cloud (points on a sphere and inside it,
     /// one on a segment between two of them) is the hull of all its points.
     #[test]
+    fn the_filter_drops_only_points_strictly_below() {
+        // Points a hair from random planes (relative distances from 1e-9 to 1e-3), as
+        // given and far from the origin: every point the `f32` filter drops is strictly
+        // below the plane by the exact predicate, and most of those clearly below are
+        // dropped.
+        let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
+        let (mut dropped, mut clear) = (0, 0);
+        for round in 0..200 {
+            let offset = if round % 2 == 0 { 0.0 } else { 3e4 };
+            let mut point = || {
+                (DVec3::new(next(), next(), next()) + offset)
+                    .as_vec3()
+                    .as_dvec3()
+            };
+            let [a, b, c] = [point(), point(), point()];
+            let Some(plane) = FilterPlane::new([a, b, c], 4e4 * 3.0) else {
+                panic!("a plane of ordinary size");
+            };
+            let normal = (b - a).cross(c - a).normalize();
+            let points: Vec<DVec3> = (0..64)
+                .map(|k| {
+                    let (u, v) = (next().abs(), next().abs());
+                    let height = next() * 10f64.powi(-(k % 7) - 3) * (1.0 + offset);
+                    (a + (b - a) * u + (c - a) * v + normal * height)
+                        .as_vec3()
+                        .as_dvec3()
+                })
+                .collect();
+            let [x, y, z] =
+                [0, 1, 2].map(|k| points.iter().map(|p| p[k] as f32).collect::<Vec<_>>());
+            let mut inside = vec![true; points.len()];
+            plane.below(&x, &y, &z, &mut inside);
+            for (p, inside) in points.iter().zip(inside) {
+                let below = orient3d(coord(a), coord(b), coord(c), coord(*p)) > 0.0;
+                assert!(!inside || below, "{p} dropped but not below {a} {b} {c}");
+                dropped += usize::from(inside);
+                clear += usize::from((*p - a).dot(normal) < -1e-4 * (1.0 + offset));
+            }
+        }
+        assert!(
+            dropped >= clear && clear > 500,
+            "{dropped} dropped, {clear} clearly below"
+        );
+    }
+
+    #[test]
     fn the_extremal_filter_keeps_every_vertex() {
         let mut next = crate::num::uniform(0x2545_f491_4f6c_dd1d);
         let mut points: Vec<DVec3> = (0..2000)
@@ -1031,11 +1123,28 @@ mod tests {
             }
             _ => panic!("a ball is solid"),
         };
-        let filtered = vertices(convex_hull(&points));
-        let mut full = Quickhull::new(&points, tetrahedron(&points).expect("a solid"));
-        full.run();
-        assert_eq!(filtered, vertices(full.into_hull()));
-        assert_eq!(filtered.len(), 667, "every point on the sphere");
+        // As given, moved far from the origin, and scaled near the bottom of `f32`'s range
+        // (where the filter refuses its planes and keeps every point).
+        for (scale, offset, drops) in [(1.0, 0.0, true), (3.0, 1e4, true), (1e-36, 0.0, false)] {
+            let points: Vec<DVec3> = points
+                .iter()
+                .map(|&p| (p * scale + DVec3::splat(offset)).as_vec3().as_dvec3())
+                .collect();
+            let seed = tetrahedron(&points).expect("a solid");
+            let kept = outside_extremal_hull(&points, seed).len();
+            assert_eq!(
+                kept < points.len() / 2,
+                drops,
+                "{scale} {offset}: {kept} kept"
+            );
+            let filtered = vertices(convex_hull(&points));
+            let mut full = Quickhull::new(&points, seed);
+            full.run();
+            assert_eq!(filtered, vertices(full.into_hull()), "{scale} {offset}");
+            if scale == 1.0 {
+                assert_eq!(filtered.len(), 667, "every point on the sphere");
+            }
+        }
     }
 
     /// The outline that tests only the cells `n` may split holds the same vertices as a test
