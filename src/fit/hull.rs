@@ -496,7 +496,8 @@ fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
         .all(|&(i, j)| orient2d(project(a, i, j), project(b, i, j), project(c, i, j)) == 0.0)
 }
 
-/// The hull of distinct points.
+/// The hull of distinct points, each an `f32` value (as every fit's points are: the
+/// extremal filter relies on it).
 pub(crate) fn convex_hull(points: &[DVec3]) -> Hull {
     let seed = match tetrahedron(points) {
         Ok(seed) => seed,
@@ -704,7 +705,7 @@ impl Plane {
 ///
 /// **The bound.** With `D = p − a` exact and `H = ((b − a) × (c − a))·D` exact, each
 /// `|n_i| <= |b − a|₁·|c − a|₁`, so `S = |b − a|₁·|c − a|₁·|D|₁` bounds `Σ|n_i·D_i|`. The
-/// `f64` normal is within a few `2^-53` of `S/|D|₁` per component; rounding it to `f32`,
+/// `f64` normal errs by a few `2^-53·|b − a|₁·|c − a|₁` per component; rounding it to `f32`,
 /// the three differences `d = fl(p − a)`, the three products and the two sums add at most
 /// `γ₃₂(6) < 2^-21.4` of `S` and, where products underflow, `3·2^-150`. The computed height
 /// `h` is therefore within `2^-21·S + 2^-147` of `H`. The computed reach
