@@ -120,6 +120,10 @@ fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
 /// (counter-clockwise seen from outside), as indices into `points`, and how many there
 /// are; `None` for points that span no solid, or arrays that would overflow (see the
 /// module doc).
+///
+/// Each point is tested against every triangle's plane at once, in lanes over the planes
+/// held as columns ([`hull::side_code`]), and `orient3d` decides where the pad leaves the
+/// side open. The new triangles take the slots of the seen ones, so nothing moves.
 fn triangles(points: &[DVec3]) -> Option<([[u8; 3]; FACES], usize)> {
     if points.len() > POINTS {
         return None;
@@ -131,70 +135,131 @@ fn triangles(points: &[DVec3]) -> Option<([[u8; 3]; FACES], usize)> {
     } else {
         (b, c)
     };
-    let plane = |f: [u8; 3]| {
-        let [u, v, w] = f.map(at);
-        Plane::new(u, v, w)
-    };
-    let mut faces = [[0u8; 3]; FACES];
-    faces[..4].copy_from_slice(&[[a, b, c], [b, a, d], [c, b, d], [a, c, d]]);
-    let mut planes = [plane(faces[0]); FACES];
-    for f in 1..4 {
-        planes[f] = plane(faces[f]);
-    }
-    let mut len = 4;
-    let mut horizon = [[0u8; 2]; 3 * FACES];
-    for (i, &p) in points.iter().enumerate() {
-        if [a, b, c, d].contains(&(i as u8)) {
-            continue;
+    crate::simd::plain(
+        #[inline(always)]
+        || {
+            let mut hull = SmallHull::default();
+            for face in [[a, b, c], [b, a, d], [c, b, d], [a, c, d]] {
+                hull.put(hull.len, face, points);
+                hull.len += 1;
+            }
+            for (i, &p) in points.iter().enumerate() {
+                if ![a, b, c, d].contains(&(i as u8)) && !hull.insert(i as u8, p, points) {
+                    return None;
+                }
+            }
+            Some((hull.faces, hull.len))
+        },
+    )
+}
+
+/// The hull being built by [`triangles`]: its triangles, their planes as columns (the
+/// slots from `len` on are unused), and the edges the current point's seen triangles run.
+struct SmallHull {
+    faces: [[u8; 3]; FACES],
+    normal: [[f64; FACES]; 3],
+    vertex: [[f64; FACES]; 3],
+    pad: [f64; FACES],
+    len: usize,
+    /// `runs[u][v] == stamp` when a triangle that the point with that stamp sees runs
+    /// `u → v`.
+    runs: [[u8; POINTS]; POINTS],
+}
+
+impl Default for SmallHull {
+    fn default() -> Self {
+        Self {
+            faces: [[0; 3]; FACES],
+            normal: [[0.0; FACES]; 3],
+            vertex: [[0.0; FACES]; 3],
+            pad: [0.0; FACES],
+            len: 0,
+            runs: [[0; POINTS]; POINTS],
         }
-        let sees = |f: usize| {
-            planes[f].side(p).unwrap_or_else(|| {
-                let [u, v, w] = faces[f].map(at);
-                hull::above(u, v, w, p)
-            })
-        };
-        let mut seen = [false; FACES];
-        let mut list = [0usize; FACES];
+    }
+}
+
+impl SmallHull {
+    /// Puts the triangle `face` (indices into `points`) and its plane in `slot`.
+    #[inline(always)]
+    fn put(&mut self, slot: usize, face: [u8; 3], points: &[DVec3]) {
+        let [u, v, w] = face.map(|i| points[usize::from(i)]);
+        let (n, a, pad) = Plane::new(u, v, w).parts();
+        for k in 0..3 {
+            (self.normal[k][slot], self.vertex[k][slot]) = (n[k], a[k]);
+        }
+        (self.faces[slot], self.pad[slot]) = (face, pad);
+    }
+
+    /// Adds the point `i` (at `p`): the triangles it sees give way to a fan from `i` over
+    /// their horizon. `false` when the arrays would overflow.
+    #[inline(always)]
+    fn insert(&mut self, i: u8, p: DVec3, points: &[DVec3]) -> bool {
+        let q = p.to_array();
+        let mut code = [0i8; FACES];
+        for (f, code) in code.iter_mut().enumerate() {
+            let n = [0, 1, 2].map(|k| self.normal[k][f]);
+            let a = [0, 1, 2].map(|k| self.vertex[k][f]);
+            *code = hull::side_code(n, a, self.pad[f], q);
+        }
+        let stamp = i + 1;
+        let mut seen = [0usize; FACES];
         let mut count = 0;
-        for (f, seen) in seen.iter_mut().enumerate().take(len) {
-            if sees(f) {
-                (*seen, list[count]) = (true, f);
+        for (f, &code) in code.iter().enumerate().take(self.len) {
+            let sees = code > 0
+                || (code == 0 && {
+                    let [u, v, w] = self.faces[f].map(|j| points[usize::from(j)]);
+                    hull::above(u, v, w, p)
+                });
+            if sees {
+                seen[count] = f;
                 count += 1;
+                let [u, v, w] = self.faces[f].map(usize::from);
+                (self.runs[u][v], self.runs[v][w], self.runs[w][u]) = (stamp, stamp, stamp);
             }
         }
         if count == 0 {
-            continue;
+            return true;
         }
         // A seen triangle's edge is on the horizon when no seen triangle runs it backwards.
+        let mut horizon = [[0u8; 2]; 3 * FACES];
         let mut edges = 0;
-        for &f in &list[..count] {
+        for &f in &seen[..count] {
+            let face = self.faces[f];
             for k in 0..3 {
-                let (u, v) = (faces[f][k], faces[f][(k + 1) % 3]);
-                let runs_back =
-                    |g: &usize| (0..3).any(|j| faces[*g][j] == v && faces[*g][(j + 1) % 3] == u);
-                if !list[..count].iter().any(runs_back) {
+                let (u, v) = (face[k], face[(k + 1) % 3]);
+                if self.runs[usize::from(v)][usize::from(u)] != stamp {
                     horizon[edges] = [u, v];
                     edges += 1;
                 }
             }
         }
-        let mut kept = 0;
-        for f in 0..len {
-            if !seen[f] {
-                (faces[kept], planes[kept]) = (faces[f], planes[f]);
-                kept += 1;
+        if self.len - count + edges > FACES {
+            return false;
+        }
+        // The fan fills the seen slots, then new ones; seen slots left over (never, for a
+        // horizon that is one cycle) take the last triangles, highest slot first.
+        for (k, &[u, v]) in horizon[..edges].iter().enumerate() {
+            let slot = if k < count {
+                seen[k]
+            } else {
+                self.len + k - count
+            };
+            self.put(slot, [u, v, i], points);
+        }
+        self.len += edges.saturating_sub(count);
+        for &slot in seen[edges.min(count)..count].iter().rev() {
+            self.len -= 1;
+            let last = self.len;
+            self.faces[slot] = self.faces[last];
+            self.pad[slot] = self.pad[last];
+            for k in 0..3 {
+                self.normal[k][slot] = self.normal[k][last];
+                self.vertex[k][slot] = self.vertex[k][last];
             }
         }
-        if kept + edges > FACES {
-            return None;
-        }
-        for (k, &[u, v]) in horizon[..edges].iter().enumerate() {
-            faces[kept + k] = [u, v, i as u8];
-            planes[kept + k] = plane(faces[kept + k]);
-        }
-        len = kept + edges;
+        true
     }
-    Some((faces, len))
 }
 
 /// The best face frame of the hull of `points` (distinct, at most [`POINTS`]), with its

@@ -686,17 +686,28 @@ impl Plane {
     /// `Some(false)` strictly below, `None` within the pad (undecided).
     #[inline]
     pub(crate) fn side(&self, p: DVec3) -> Option<bool> {
-        let d = p - self.a;
-        let height = self.n.dot(d);
-        let pad = self.pad * d.abs().element_sum();
-        if height > pad {
-            Some(true)
-        } else if height < -pad {
-            Some(false)
-        } else {
-            None
+        match side_code(self.n.to_array(), self.a.to_array(), self.pad, p.to_array()) {
+            1 => Some(true),
+            -1 => Some(false),
+            _ => None,
         }
     }
+
+    /// The normal, the vertex and the pad factor, as arrays (for planes held as columns).
+    pub(crate) fn parts(&self) -> ([f64; 3], [f64; 3], f64) {
+        (self.n.to_array(), self.a.to_array(), self.pad)
+    }
+}
+
+/// [`Plane::side`] from the plane's parts (`n`, `a`, `pad`): `1` strictly above, `-1`
+/// strictly below, `0` within the pad. Branch-free, so that a loop over planes held as
+/// columns runs in lanes.
+#[inline(always)]
+pub(crate) fn side_code(n: [f64; 3], a: [f64; 3], pad: f64, p: [f64; 3]) -> i8 {
+    let d = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let height = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+    let reach = pad * (d[0].abs() + d[1].abs() + d[2].abs());
+    i8::from(height > reach) - i8::from(height < -reach)
 }
 
 /// A face's plane for [`outside_extremal_hull`]'s filter, in `f32`: a vertex `a` (the

@@ -240,22 +240,31 @@ pub(crate) const DIRECTIONS: usize = 13;
 /// dot product `(x·n_x + y·n_y) + z·n_z` (up to the sign of a zero), at the cost of 10 sums.
 #[inline(always)]
 pub(crate) fn projections(x: f32, y: f32, z: f32) -> [f32; DIRECTIONS] {
-    let (sum, difference) = (x + y, x - y);
-    [
-        x,
-        y,
-        z,
-        sum + z,
-        sum - z,
-        difference + z,
-        difference - z,
-        sum,
-        difference,
-        x + z,
-        x - z,
-        y + z,
-        y - z,
-    ]
+    let mut q = [0.0; DIRECTIONS];
+    for (k, q) in q.iter_mut().enumerate() {
+        *q = projection(k, x, y, z);
+    }
+    q
+}
+
+/// The `k`-th of [`projections`] alone (the sums that it needs, in the same order).
+#[inline(always)]
+fn projection(k: usize, x: f32, y: f32, z: f32) -> f32 {
+    match k {
+        0 => x,
+        1 => y,
+        2 => z,
+        3 => (x + y) + z,
+        4 => (x + y) - z,
+        5 => (x - y) + z,
+        6 => (x - y) - z,
+        7 => x + y,
+        8 => x - y,
+        9 => x + z,
+        10 => x - z,
+        11 => y + z,
+        _ => y - z,
+    }
 }
 
 /// An extreme projection found so far: its value, and the points among which its first
@@ -398,10 +407,10 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
         },
     );
     // The tail (fewer than `WIDTH` points), one point at a time: its sums go to lane 0.
-    let project = |p: Vec3| projections(p.x, p.y, p.z);
+    let project = |k: usize, p: Vec3| projection(k, p.x, p.y, p.z);
     let tail = points.len() - points.len() % WIDTH;
     for (i, &p) in points.iter().enumerate().skip(tail) {
-        for (q, [lo, hi]) in project(p).into_iter().zip(&mut extremes) {
+        for (q, [lo, hi]) in projections(p.x, p.y, p.z).into_iter().zip(&mut extremes) {
             let here = Extreme {
                 value: q,
                 start: i,
@@ -435,7 +444,7 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             ends.map(|e| {
                 // The first point of its chunk with the value; when none has it (an
                 // overflowing projection), any point will do.
-                let first = e.first(points, |p| project(p)[k]).unwrap_or(e.start);
+                let first = e.first(points, |p| project(k, p)).unwrap_or(e.start);
                 points.get(first).map_or(DVec3::ZERO, |p| p.as_dvec3())
             })
         })
