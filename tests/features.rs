@@ -41,14 +41,14 @@ mod serde_round_trip {
     use serde::{Serialize, de::DeserializeOwned};
     use std::fmt::Debug;
 
-    /// `value` through postcard and back: the same bytes again (postcard stores an `f32` as
-    /// its bits, so this is a bitwise round trip, NaN payloads included).
+    /// `value` through MessagePack and back: the same bytes again (MessagePack stores an
+    /// `f32` as its bits, so this is a bitwise round trip, NaN payloads included).
     fn bitwise<T: Serialize + DeserializeOwned + Debug + PartialEq>(value: T) {
-        let bytes = postcard::to_allocvec(&value).expect("serialises");
-        let back: T = postcard::from_bytes(&bytes).expect("deserialises");
-        assert_eq!(postcard::to_allocvec(&back).unwrap(), bytes, "{value:?}");
+        let bytes = rmp_serde::to_vec(&value).expect("serialises");
+        let back: T = rmp_serde::from_slice(&bytes).expect("deserialises");
+        assert_eq!(rmp_serde::to_vec(&back).unwrap(), bytes, "{value:?}");
         // Truncated input is an error, never a panic or a plausible value.
-        assert!(postcard::from_bytes::<T>(&bytes[..bytes.len() - 1]).is_err());
+        assert!(rmp_serde::from_slice::<T>(&bytes[..bytes.len() - 1]).is_err());
     }
 
     /// `value` through JSON and back, equal, and its JSON text as written.
