@@ -1,6 +1,6 @@
 //! The optional features: `serde` round trips, `bytemuck` casts, and what the crate does
-//! without `std`. Run with `--all-features` and `--no-default-features` (`.ci/run` does);
-//! each part compiles only under its feature.
+//! without `std`. Run with `--features rayon,serde,bytemuck` and `--no-default-features`
+//! (`.ci/run` does); each part compiles only under its feature.
 
 use bvkit::Backend;
 
