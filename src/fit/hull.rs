@@ -80,7 +80,8 @@ const SCANNED: usize = 32;
 /// on the teapot's hull of 878 vertices.
 const FAR_SCANNED: usize = 1024;
 
-/// Triangles per lane group of [`Solid::shadow`].
+/// Triangles per lane group of [`Solid::shadow`], and points per lane group of
+/// [`first_least_last_greatest`] (four `f64` lanes).
 const LANES: usize = 4;
 
 /// A cell of edges ([`Solid::outline`]): those up to `end` in [`Solid::edges`] (from the
@@ -603,21 +604,24 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     if points.len() < 64 {
         return all();
     }
+    // The points in coordinate columns: exact `f64` for the extremes, exact `f32` for the
+    // filter.
+    let x: Vec<f64> = points.iter().map(|p| p.x).collect();
+    let y: Vec<f64> = points.iter().map(|p| p.y).collect();
+    let z: Vec<f64> = points.iter().map(|p| p.z).collect();
     let mut extremal: Vec<usize> = seed.to_vec();
-    for n in DIRECTIONS.map(DVec3::from_array) {
-        // The first least and the last greatest projection.
-        let (mut lo, mut hi) = ((f64::INFINITY, 0), (f64::NEG_INFINITY, 0));
-        for (i, p) in points.iter().enumerate() {
-            let h = p.dot(n);
-            if h < lo.0 {
-                lo = (h, i);
+    // A plain loop: the closure of `array::map` is not inlined into the backend's wrapper.
+    let ends = crate::simd::plain(
+        #[inline(always)]
+        || {
+            let mut ends = [[0; 2]; DIRECTIONS.len()];
+            for (ends, &n) in ends.iter_mut().zip(&DIRECTIONS) {
+                *ends = first_least_last_greatest(&x, &y, &z, n);
             }
-            if h >= hi.0 {
-                hi = (h, i);
-            }
-        }
-        extremal.extend([lo.1, hi.1]);
-    }
+            ends
+        },
+    );
+    extremal.extend(ends.into_iter().flatten());
     extremal.sort_unstable();
     extremal.dedup();
     let subset: Vec<DVec3> = extremal.iter().map(|&i| points[i]).collect();
@@ -640,9 +644,8 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let Some(faces) = faces else {
         return all();
     };
-    // The points in coordinate columns (exact in `f32`), each face tested on all of them
-    // in lanes.
-    let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k] as f32).collect::<Vec<f32>>());
+    // Each face tested on all the points in lanes.
+    let [x, y, z] = [&x, &y, &z].map(|c| c.iter().map(|&v| v as f32).collect::<Vec<f32>>());
     let inside = crate::simd::plain(
         #[inline(always)]
         || {
@@ -656,6 +659,55 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     (0..points.len())
         .filter(|&i| extremal.binary_search(&i).is_ok() || !inside[i])
         .collect()
+}
+
+/// The indices of the first least and the last greatest `n·p` over the points given as
+/// columns (as the `f64` value of `p.dot(n)`, so the same points as a scan one at a time):
+/// plain array code over groups of [`LANES`] points, each lane keeping its own first least
+/// and last greatest, merged by index at the end, then the last partial group.
+#[inline(always)]
+fn first_least_last_greatest(x: &[f64], y: &[f64], z: &[f64], n: [f64; 3]) -> [usize; 2] {
+    let height = |i: usize| x[i] * n[0] + y[i] * n[1] + z[i] * n[2];
+    let (groups, _) = x.as_chunks::<LANES>();
+    let (yg, zg) = (
+        &y.as_chunks::<LANES>().0[..groups.len()],
+        &z.as_chunks::<LANES>().0[..groups.len()],
+    );
+    let (mut lo, mut lo_at) = ([f64::INFINITY; LANES], [0usize; LANES]);
+    let (mut hi, mut hi_at) = ([f64::NEG_INFINITY; LANES], [0usize; LANES]);
+    for (g, xs) in groups.iter().enumerate() {
+        let (ys, zs) = (&yg[g], &zg[g]);
+        for j in 0..LANES {
+            let h = xs[j] * n[0] + ys[j] * n[1] + zs[j] * n[2];
+            let at = g * LANES + j;
+            let less = h < lo[j];
+            lo[j] = if less { h } else { lo[j] };
+            lo_at[j] = if less { at } else { lo_at[j] };
+            let more = h >= hi[j];
+            hi[j] = if more { h } else { hi[j] };
+            hi_at[j] = if more { at } else { hi_at[j] };
+        }
+    }
+    // Across lanes: the least value at its first index, the greatest at its last.
+    let (mut least, mut greatest) = ((f64::INFINITY, 0), (f64::NEG_INFINITY, 0));
+    for j in 0..LANES {
+        if lo[j] < least.0 || (lo[j] == least.0 && lo_at[j] < least.1) {
+            least = (lo[j], lo_at[j]);
+        }
+        if hi[j] > greatest.0 || (hi[j] == greatest.0 && hi_at[j] > greatest.1) {
+            greatest = (hi[j], hi_at[j]);
+        }
+    }
+    for i in groups.len() * LANES..x.len() {
+        let h = height(i);
+        if h < least.0 {
+            least = (h, i);
+        }
+        if h >= greatest.0 {
+            greatest = (h, i);
+        }
+    }
+    [least.1, greatest.1]
 }
 
 /// A face's plane, for a filter on the side of a point: a vertex `a`, the normal
@@ -1108,6 +1160,29 @@ mod tests {
             dropped >= clear && clear > 500,
             "{dropped} dropped, {clear} clearly below"
         );
+    }
+
+    #[test]
+    fn the_lane_scan_finds_the_first_least_and_the_last_greatest() {
+        let mut next = crate::num::uniform(0x9e37_79b9_7f4a_7c15);
+        // Coordinates from a few values, so that many points tie on every direction; every
+        // length up to a few groups, so that each lane and the partial group hold extremes.
+        for len in 1..40 {
+            let points: Vec<DVec3> = (0..len)
+                .map(|_| DVec3::new(next(), next(), next()).map(|v| (v * 2.0).round()))
+                .collect();
+            let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).collect::<Vec<_>>());
+            for n in DIRECTIONS {
+                let h = |i: usize| points[i].dot(DVec3::from_array(n));
+                let least = (0..len).reduce(|a, i| if h(i) < h(a) { i } else { a });
+                let greatest = (0..len).reduce(|a, i| if h(i) >= h(a) { i } else { a });
+                assert_eq!(
+                    first_least_last_greatest(&x, &y, &z, n),
+                    [least.unwrap(), greatest.unwrap()],
+                    "{len} points along {n:?}"
+                );
+            }
+        }
     }
 
     #[test]
