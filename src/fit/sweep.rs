@@ -267,6 +267,37 @@ fn projection(k: usize, x: f32, y: f32, z: f32) -> f32 {
     }
 }
 
+/// The least and greatest projections on the sample directions `set` (indices of
+/// [`projections`]) of the points of `columns` (groups' coordinate columns), lane by lane,
+/// written into `lo` and `hi` at those indices. A set small enough that its lanes stay in
+/// registers over all the groups: 13 directions at once need 26 registers, and spill.
+#[inline(always)]
+fn extremes_of<const N: usize>(
+    columns: &[[[f32; WIDTH]; 3]],
+    set: [usize; N],
+    lo: &mut [[f32; WIDTH]; DIRECTIONS],
+    hi: &mut [[f32; WIDTH]; DIRECTIONS],
+) {
+    let mut least = [[f32::INFINITY; WIDTH]; N];
+    let mut greatest = [[f32::NEG_INFINITY; WIDTH]; N];
+    for [x, y, z] in columns {
+        for j in 0..WIDTH {
+            for n in 0..N {
+                let q = projection(set[n], x[j], y[j], z[j]);
+                least[n][j] = if q < least[n][j] { q } else { least[n][j] };
+                greatest[n][j] = if q > greatest[n][j] {
+                    q
+                } else {
+                    greatest[n][j]
+                };
+            }
+        }
+    }
+    for n in 0..N {
+        (lo[set[n]], hi[set[n]]) = (least[n], greatest[n]);
+    }
+}
+
 /// An extreme projection found so far: its value, and the points among which its first
 /// point lies: those of the chunk `start..start + len` in the lanes of the mask `lanes`
 /// (point `start + i` is in lane `i mod WIDTH`), or one point of the tail.
@@ -324,6 +355,12 @@ const ENTRIES: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2
 /// The [`Summary`] of the points, in one sweep (the points are read once: on large inputs
 /// the sweeps are bound by memory, not arithmetic).
 ///
+/// **Registers.** The 26 extremes and 9 sums, in lanes, would take 44 registers of AVX2's
+/// 16, and spill on every group. So each chunk is transposed once into columns
+/// (3 KB, in L1 cache), then swept by three sets of directions ([`extremes_of`]) and the
+/// two halves of the `f64` sums in turn, each of whose lanes stays in registers. Every sum
+/// sees its terms in the same order as in a single pass.
+///
 /// **Extremes.** The lanes keep only the least and greatest values of each chunk of
 /// [`CHUNK`] groups (the last chunk may be shorter; only the last `n mod WIDTH` points go
 /// one at a time); a chunk that strictly improves an extreme becomes its chunk, and the
@@ -353,29 +390,34 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
             let mut best = [[none(f32::INFINITY), none(f32::NEG_INFINITY)]; DIRECTIONS];
             let mut sum = [[0.0f64; WIDTH]; 3];
             let mut products = [[0.0f64; WIDTH]; 6];
+            // Each chunk's groups as columns, swept several times while they are in cache.
+            let mut buffer = [[[0.0f32; WIDTH]; 3]; CHUNK];
             // The last chunk may be short; its full groups still run in lanes.
             for (c, chunk) in points.chunks(CHUNK * WIDTH).enumerate() {
+                let groups = chunk.as_chunks::<WIDTH>().0;
+                for (columns_of, group) in buffer.iter_mut().zip(groups) {
+                    *columns_of = columns(group);
+                }
+                let buffer = &buffer[..groups.len()];
                 let mut lo = [[f32::INFINITY; WIDTH]; DIRECTIONS];
                 let mut hi = [[f32::NEG_INFINITY; WIDTH]; DIRECTIONS];
-                for group in chunk.as_chunks::<WIDTH>().0 {
-                    let [x, y, z] = columns(group);
-                    for j in 0..WIDTH {
-                        let q = projections(x[j], y[j], z[j]);
-                        for k in 0..DIRECTIONS {
-                            lo[k][j] = if q[k] < lo[k][j] { q[k] } else { lo[k][j] };
-                            hi[k][j] = if q[k] > hi[k][j] { q[k] } else { hi[k][j] };
+                // Each set's least and greatest lanes stay in registers over the chunk.
+                extremes_of(buffer, [0, 1, 2, 7, 8], &mut lo, &mut hi);
+                extremes_of(buffer, [3, 4, 5, 6], &mut lo, &mut hi);
+                extremes_of(buffer, [9, 10, 11, 12], &mut lo, &mut hi);
+                for half in [0, WIDTH / 2] {
+                    for [x, y, z] in buffer {
+                        let mut d = [[0.0f64; WIDTH / 2]; 3];
+                        for (i, column) in [x, y, z].iter().enumerate() {
+                            for j in 0..WIDTH / 2 {
+                                d[i][j] = f64::from(column[half + j]) - s[i];
+                                sum[i][half + j] += d[i][j];
+                            }
                         }
-                    }
-                    let mut d = [[0.0f64; WIDTH]; 3];
-                    for (i, column) in [x, y, z].iter().enumerate() {
-                        for j in 0..WIDTH {
-                            d[i][j] = f64::from(column[j]) - s[i];
-                            sum[i][j] += d[i][j];
-                        }
-                    }
-                    for (e, &(i, k)) in ENTRIES.iter().enumerate() {
-                        for j in 0..WIDTH {
-                            products[e][j] += d[i][j] * d[k][j];
+                        for (e, &(i, k)) in ENTRIES.iter().enumerate() {
+                            for j in 0..WIDTH / 2 {
+                                products[e][half + j] += d[i][j] * d[k][j];
+                            }
                         }
                     }
                 }
@@ -617,5 +659,54 @@ mod tests {
         assert!(!summary(&bad).finite);
         bad[800].x = 0.0;
         assert!(summary(&bad).finite);
+    }
+
+    /// The moments are the sums that [`summary`] documents, bitwise: `d = p − s` about the
+    /// first point, point `i` of the full groups into partial sum `i mod WIDTH` and the tail
+    /// into the first, each in the points' order, the partial sums added in order.
+    #[test]
+    fn moments_are_the_partial_sums_in_their_order() {
+        let points: Vec<Vec3> = (0..CHUNK * WIDTH * 2 + 77)
+            .map(|i| {
+                let t = i as f32;
+                Vec3::new(
+                    (t * 0.3).sin() * 3.0 + 10.0,
+                    (t * 0.17).cos() - 2.0,
+                    t * 1e-3,
+                )
+            })
+            .collect();
+        let s = points[0].as_dvec3();
+        let full = points.len() - points.len() % WIDTH;
+        let mut sum = [[0.0f64; WIDTH]; 3];
+        let mut products = [[0.0f64; WIDTH]; 6];
+        for (i, p) in points.iter().enumerate() {
+            let lane = if i < full { i % WIDTH } else { 0 };
+            let d = (p.as_dvec3() - s).to_array();
+            for k in 0..3 {
+                sum[k][lane] += d[k];
+            }
+            for (e, &(a, b)) in ENTRIES.iter().enumerate() {
+                products[e][lane] += d[a] * d[b];
+            }
+        }
+        let n = points.len() as f64;
+        let offset = DVec3::from_array(sum.map(|x| x.iter().sum::<f64>() / n));
+        let c = products.map(|x| x.iter().sum::<f64>() / n);
+        let raw = DMat3::from_cols_array_2d(&[
+            [c[0], c[1], c[2]],
+            [c[1], c[3], c[4]],
+            [c[2], c[4], c[5]],
+        ]);
+        let shift = DMat3::from_cols(offset * offset.x, offset * offset.y, offset * offset.z);
+        let found = summary(&points);
+        assert_eq!(
+            found.mean.to_array().map(f64::to_bits),
+            (s + offset).to_array().map(f64::to_bits)
+        );
+        assert_eq!(
+            found.covariance.to_cols_array().map(f64::to_bits),
+            (raw - shift).to_cols_array().map(f64::to_bits)
+        );
     }
 }
