@@ -22,8 +22,6 @@ use super::hull::{self, Plane};
 use super::rect;
 use super::sweep;
 use crate::num::pow2;
-use alloc::vec;
-use alloc::vec::Vec;
 use glam::{DMat3, DVec3};
 
 /// At most this many points: the extremes on each sample direction of the summary.
@@ -41,12 +39,31 @@ const RECTANGLES: usize = 8;
 /// The frame of least volume over `points` (distinct, at most [`POINTS`], the first 14
 /// paired along DiTO's 7 directions) among DiTO's frames of the first 14 and the face
 /// frames of the hull of all ([`face_frame`]); `None` when there is none (fewer than
-/// three points, or all on a line).
+/// three points, or all on a line) or there are more than [`POINTS`] points.
+///
+/// DiTO's frames are ranked by the volume of the points' box on their axes, each extent
+/// taken in lanes over the points as columns ([`extent`]).
 pub(crate) fn best_frame(points: &[DVec3], dito: &[DVec3]) -> Option<DMat3> {
-    let best = dito_frames(dito)
-        .into_iter()
-        .map(|f| (volume_over(&f, points), f))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
+    if points.len() > POINTS {
+        return None;
+    }
+    let (column, _) = columns(points, [true; POINTS]);
+    let (frames, count) = dito_frames(dito);
+    let best = crate::simd::plain(
+        #[inline(always)]
+        || {
+            let mut best: Option<(f64, DMat3)> = None;
+            for frame in &frames[..count] {
+                let volume = extent(&column, frame.x_axis)
+                    * extent(&column, frame.y_axis)
+                    * extent(&column, frame.z_axis);
+                if best.is_none_or(|(least, _)| volume.total_cmp(&least).is_lt()) {
+                    best = Some((volume, *frame));
+                }
+            }
+            best
+        },
+    );
     face_frame(points, best).map(|(_, f)| f)
 }
 
@@ -60,11 +77,6 @@ pub(crate) fn extents(frame: &DMat3, points: &[DVec3]) -> DVec3 {
         hi = hi.max(q);
     }
     (hi - lo).max(DVec3::ZERO)
-}
-
-/// The volume of the box with axes `frame` around `points`.
-pub(crate) fn volume_over(frame: &DMat3, points: &[DVec3]) -> f64 {
-    extents(frame, points).element_product()
 }
 
 /// A right-handed orthonormal frame whose first axis is `axis` and second the part of
@@ -82,7 +94,9 @@ pub(crate) fn frame_from(axis: DVec3, toward: DVec3) -> Option<DMat3> {
 /// point farthest from their line; the points farthest above and below its plane add a
 /// tetrahedron on each side. Each triangle gives one frame per edge: the edge, the
 /// in-plane orthogonal, the normal.
-fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
+fn dito_frames(extremal: &[DVec3]) -> ([DMat3; DITO_FRAMES], usize) {
+    let mut frames = [DMat3::ZERO; DITO_FRAMES];
+    let mut count = 0;
     let farthest = |key: &dyn Fn(DVec3) -> f64| {
         extremal
             .iter()
@@ -98,23 +112,35 @@ fn dito_frames(extremal: &[DVec3]) -> Vec<DMat3> {
                 .total_cmp(&b.0.distance_squared(b.1))
         })
     else {
-        return Vec::new();
+        return (frames, count);
     };
     let line = (p1 - p0).normalize_or_zero();
     let p2 = farthest(&|p| (p - p0).cross(line).length_squared());
     let normal = (p1 - p0).cross(p2 - p0);
-    let mut triangles = vec![[p0, p1, p2]];
-    for apex in [farthest(&|p| p.dot(normal)), farthest(&|p| -p.dot(normal))] {
-        triangles.extend([[p0, p1, apex], [p1, p2, apex], [p2, p0, apex]]);
+    let [above, below] = [farthest(&|p| p.dot(normal)), farthest(&|p| -p.dot(normal))];
+    let triangles = [
+        [p0, p1, p2],
+        [p0, p1, above],
+        [p1, p2, above],
+        [p2, p0, above],
+        [p0, p1, below],
+        [p1, p2, below],
+        [p2, p0, below],
+    ];
+    for t in triangles {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        for k in 0..3 {
+            if let Some(frame) = frame_from(t[(k + 1) % 3] - t[k], n) {
+                frames[count] = frame;
+                count += 1;
+            }
+        }
     }
-    triangles
-        .iter()
-        .flat_map(|t| {
-            let n = (t[1] - t[0]).cross(t[2] - t[0]);
-            (0..3).filter_map(move |k| frame_from(t[(k + 1) % 3] - t[k], n))
-        })
-        .collect()
+    (frames, count)
 }
+
+/// DiTO's frames: 3 for each of its 7 triangles.
+const DITO_FRAMES: usize = 21;
 
 /// The triangles of the hull of `points` (distinct, at most [`POINTS`]), outward
 /// (counter-clockwise seen from outside), as indices into `points`, and how many there
@@ -469,6 +495,7 @@ fn shadow(area: &[[f64; FACES]; 3], n: DVec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::vec::Vec;
 
     /// Points in general position, some inside the hull of the others.
     fn cloud(n: usize) -> Vec<DVec3> {
