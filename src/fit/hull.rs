@@ -13,6 +13,7 @@
 //! containment never depends on it (every fit re-derives its extents from every input
 //! point).
 
+use super::sweep::SAMPLE_DIRECTIONS;
 use crate::num::pow2;
 use alloc::boxed::Box;
 use alloc::vec;
@@ -572,28 +573,10 @@ fn last_greatest(
     best.1
 }
 
-/// Sample directions for [`outside_extremal_hull`]: the coordinate axes, the cube
-/// diagonals and the face diagonals.
-const DIRECTIONS: [[f64; 3]; 13] = [
-    [1.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [1.0, 1.0, -1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, 0.0],
-    [1.0, -1.0, 0.0],
-    [1.0, 0.0, 1.0],
-    [1.0, 0.0, -1.0],
-    [0.0, 1.0, 1.0],
-    [0.0, 1.0, -1.0],
-];
-
 /// The indices of the points that may be vertices of the hull (Akl–Toussaint): every
-/// point but those strictly inside the hull of the extremal points along [`DIRECTIONS`],
-/// which are not (a point inside the hull of others is no vertex of the hull of all). The
-/// `seed` points are always kept.
+/// point but those strictly inside the hull of the extremal points along the sample
+/// directions ([`SAMPLE_DIRECTIONS`], the fast fit's), which are not (a point inside the
+/// hull of others is no vertex of the hull of all). The `seed` points are always kept.
 ///
 /// The test is a floating-point filter that only ever drops a point it has proven inside,
 /// run in `f32` lanes ([`FilterPlane`]): a point below every face by more than its pad
@@ -614,8 +597,8 @@ fn outside_extremal_hull(points: &[DVec3], seed: [usize; 4]) -> Vec<usize> {
     let ends = crate::simd::plain(
         #[inline(always)]
         || {
-            let mut ends = [[0; 2]; DIRECTIONS.len()];
-            for (ends, &n) in ends.iter_mut().zip(&DIRECTIONS) {
+            let mut ends = [[0; 2]; SAMPLE_DIRECTIONS.len()];
+            for (ends, &n) in ends.iter_mut().zip(&SAMPLE_DIRECTIONS) {
                 *ends = first_least_last_greatest(&x, &y, &z, n);
             }
             ends
@@ -1172,7 +1155,7 @@ mod tests {
                 .map(|_| DVec3::new(next(), next(), next()).map(|v| (v * 2.0).round()))
                 .collect();
             let [x, y, z] = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).collect::<Vec<_>>());
-            for n in DIRECTIONS {
+            for n in SAMPLE_DIRECTIONS {
                 let h = |i: usize| points[i].dot(DVec3::from_array(n));
                 let least = (0..len).reduce(|a, i| if h(i) < h(a) { i } else { a });
                 let greatest = (0..len).reduce(|a, i| if h(i) >= h(a) { i } else { a });

@@ -232,6 +232,25 @@ const CHUNK: usize = 32;
 /// How many sample directions [`summary`] projects on.
 pub(crate) const DIRECTIONS: usize = 13;
 
+/// The sample directions, in the order of [`projections`]: the coordinate axes, the cube
+/// diagonals and the face diagonals (unnormalised). The tight fit's hull filter takes its
+/// extremes along the same directions, in `f64`.
+pub(crate) const SAMPLE_DIRECTIONS: [[f64; 3]; DIRECTIONS] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [1.0, 1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 0.0, 1.0],
+    [1.0, 0.0, -1.0],
+    [0.0, 1.0, 1.0],
+    [0.0, 1.0, -1.0],
+];
+
 /// The projections of `(x, y, z)` on the sample directions, in this order: the 3
 /// coordinate axes, the 4 cube diagonals `(1, ±1, ±1)` (these 7 are DiTO-14's) and the 6
 /// face diagonals `(1, ±1, 0)`, `(1, 0, ±1)`, `(0, 1, ±1)` (all 13 are EPOS-26's).
@@ -510,22 +529,10 @@ pub(crate) fn summary(points: &[Vec3]) -> Summary {
 mod tests {
     use super::*;
 
-    /// The sample directions, as vectors.
-    const VECTORS: [Vec3; DIRECTIONS] = [
-        Vec3::X,
-        Vec3::Y,
-        Vec3::Z,
-        Vec3::new(1.0, 1.0, 1.0),
-        Vec3::new(1.0, 1.0, -1.0),
-        Vec3::new(1.0, -1.0, 1.0),
-        Vec3::new(1.0, -1.0, -1.0),
-        Vec3::new(1.0, 1.0, 0.0),
-        Vec3::new(1.0, -1.0, 0.0),
-        Vec3::new(1.0, 0.0, 1.0),
-        Vec3::new(1.0, 0.0, -1.0),
-        Vec3::new(0.0, 1.0, 1.0),
-        Vec3::new(0.0, 1.0, -1.0),
-    ];
+    /// The sample directions, as `f32` vectors.
+    fn vectors() -> [Vec3; DIRECTIONS] {
+        SAMPLE_DIRECTIONS.map(|n| glam::DVec3::from_array(n).as_vec3())
+    }
 
     /// The sign of the exact sum of `f64` terms: a nonoverlapping expansion grown by TwoSum
     /// (Shewchuk 1997), whose largest nonzero component has the sign of the sum.
@@ -623,11 +630,11 @@ mod tests {
             .collect();
         points.extend_from_within(..100);
         for p in &points {
-            for (q, n) in projections(p.x, p.y, p.z).iter().zip(VECTORS) {
+            for (q, n) in projections(p.x, p.y, p.z).iter().zip(vectors()) {
                 assert_eq!(*q, p.dot(n), "{p} {n}");
             }
         }
-        let expected: Vec<DVec3> = VECTORS
+        let expected: Vec<DVec3> = vectors()
             .iter()
             .flat_map(|n| {
                 let first = |better: fn(f32, f32) -> bool| {
