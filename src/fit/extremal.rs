@@ -382,7 +382,7 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
 #[derive(Clone, Copy, Default)]
 struct Normal {
     bound: f64,
-    key: [i64; 3],
+    key: u128,
     unit: DVec3,
     extent: f64,
 }

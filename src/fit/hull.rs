@@ -477,12 +477,14 @@ fn coord(p: DVec3) -> Coord3D<f64> {
 
 /// The key that merges the directions of coplanar faces: a unit normal on a grid of
 /// `2^-24`, far coarser than the rounding of normals of faces in one plane, far finer than
-/// the angles between a mesh's distinct faces.
-pub(crate) fn direction_key(unit: DVec3) -> [i64; 3] {
-    (unit * f64::from(1u32 << 24))
-        .round()
-        .as_i64vec3()
-        .to_array()
+/// the angles between a mesh's distinct faces. Its three grid coordinates (within `±2^24`
+/// for a unit vector), offset by `2^24`, take 32 bits each, so that keys compare as the
+/// coordinate triples do, lexicographically, in one comparison.
+pub(crate) fn direction_key(unit: DVec3) -> u128 {
+    let grid = (unit * f64::from(1u32 << 24)).round() + f64::from(1u32 << 24);
+    grid.to_array().iter().fold(0, |key, &c| {
+        key << 32 | u128::from(c.clamp(0.0, f64::from(u32::MAX)) as u32)
+    })
 }
 
 /// Exact: `d` lies strictly above the plane of the counter-clockwise triangle `a, b, c`.

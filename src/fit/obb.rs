@@ -475,13 +475,13 @@ fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
     let slots = (2 * areas.len()).next_power_of_two().max(2);
     let shift = 64 - slots.trailing_zeros();
     let mut table = vec![usize::MAX; slots];
-    let mut normals: Vec<(f64, [i64; 3], usize)> = Vec::new();
+    let mut normals: Vec<(f64, u128, usize)> = Vec::new();
     for (t, area) in areas.iter().enumerate() {
         let Some(unit) = area.try_normalize() else {
             continue;
         };
         let key = direction_key(unit);
-        let hash = key.iter().fold(0u64, |h, &k| {
+        let hash = [key >> 64, key].iter().fold(0u64, |h, &k| {
             (h ^ k as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         });
         let mut slot = (hash >> shift) as usize;
@@ -501,9 +501,8 @@ fn face_normals(hull: &Solid, most: usize) -> Vec<DVec3> {
         }
     }
     // Largest first, ties in key order; only the first `most` are sorted.
-    let order = |a: &(f64, [i64; 3], usize), b: &(f64, [i64; 3], usize)| {
-        b.0.total_cmp(&a.0).then(a.1.cmp(&b.1))
-    };
+    let order =
+        |a: &(f64, u128, usize), b: &(f64, u128, usize)| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1));
     if normals.len() > most {
         normals.select_nth_unstable_by(most, order);
         normals.truncate(most);
