@@ -343,11 +343,17 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
         vertex[usize::from(i)] = true;
     }
     let (column, _) = columns(points, vertex);
-    // Which triangle runs each edge `u → v`.
+    // Which triangle runs each edge `u → v`, and so which lies across each triangle's edges.
     let mut runs = [[NO_FACE; POINTS]; POINTS];
     for (t, f) in faces.iter().enumerate() {
         for k in 0..3 {
             runs[usize::from(f[k])][usize::from(f[(k + 1) % 3])] = t as u8;
+        }
+    }
+    let mut across = [[NO_FACE; 3]; FACES];
+    for (across, f) in across.iter_mut().zip(faces) {
+        for k in 0..3 {
+            across[k] = runs[usize::from(f[(k + 1) % 3])][usize::from(f[k])];
         }
     }
     crate::simd::plain(
@@ -366,7 +372,7 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
             break;
         }
         let n = normal.unit;
-        let Some((rectangle, side)) = shadow_rectangle(faces, &runs, &area, points, n) else {
+        let Some((rectangle, side)) = shadow_rectangle(faces, &across, &area, points, n) else {
             continue;
         };
         let volume = normal.extent * rectangle;
@@ -392,7 +398,8 @@ const NO_FACE: u8 = u8::MAX;
 
 /// The minimum-area rectangle around the hull's shadow on the plane orthogonal to the unit
 /// `n`: its area and the direction of one of its sides (in that plane, not normalised);
-/// `None` when no side is found. `runs[u][v]` is the triangle that runs the edge `u → v`.
+/// `None` when no side is found. `across[t][k]` is the triangle across edge `k` of
+/// triangle `t` (from its vertex `k` to the next).
 ///
 /// **The outline.** A triangle faces `n` when `n·A > 2^-40·|A|₁` for its doubled area
 /// vector `A` (the `f64` value of `n·A` is within a few `u = 2^-53` of `|A|₁`, so a triangle
@@ -405,7 +412,7 @@ const NO_FACE: u8 = u8::MAX;
 /// [`rect::least_rectangle`].
 fn shadow_rectangle(
     faces: &[[u8; 3]],
-    runs: &[[u8; POINTS]; POINTS],
+    across: &[[u8; 3]; FACES],
     area: &[[f64; FACES]; 3],
     points: &[DVec3],
     n: DVec3,
@@ -420,12 +427,10 @@ fn shadow_rectangle(
     let mut on = [false; POINTS];
     let mut edges = [[0u8; 2]; 3 * FACES];
     let mut count = 0;
-    for (f, side) in faces.iter().zip(sides) {
+    for ((f, side), across) in faces.iter().zip(sides).zip(across) {
         for k in 0..3 {
-            let (u, v) = (usize::from(f[k]), usize::from(f[(k + 1) % 3]));
-            let across = sides.get(usize::from(runs[v][u]));
-            if side == 0 || (side == 1 && across != Some(&1)) {
-                on[u] = true;
+            if side == 0 || (side == 1 && sides.get(usize::from(across[k])) != Some(&1)) {
+                on[usize::from(f[k])] = true;
                 edges[count] = [f[k], f[(k + 1) % 3]];
                 count += 1;
             }
