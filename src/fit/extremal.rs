@@ -47,16 +47,17 @@ pub(crate) fn best_frame(points: &[DVec3], dito: &[DVec3]) -> Option<DMat3> {
     if points.len() > POINTS {
         return None;
     }
-    let (column, _) = columns(points, [true; POINTS]);
+    let (column, m) = columns(points, [true; POINTS]);
+    let groups = m.div_ceil(LANES);
     let (frames, count) = dito_frames(dito);
     let best = crate::simd::plain(
         #[inline(always)]
         || {
             let mut best: Option<(f64, DMat3)> = None;
             for frame in &frames[..count] {
-                let volume = extent(&column, frame.x_axis)
-                    * extent(&column, frame.y_axis)
-                    * extent(&column, frame.z_axis);
+                let volume = extent(&column, groups, frame.x_axis)
+                    * extent(&column, groups, frame.y_axis)
+                    * extent(&column, groups, frame.z_axis);
                 if best.is_none_or(|(least, _)| volume.total_cmp(&least).is_lt()) {
                     best = Some((volume, *frame));
                 }
@@ -342,7 +343,8 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
     for &i in faces.iter().flatten() {
         vertex[usize::from(i)] = true;
     }
-    let (column, _) = columns(points, vertex);
+    let (column, m) = columns(points, vertex);
+    let groups = m.div_ceil(LANES);
     // Which triangle runs each edge `u → v`, and so which lies across each triangle's edges.
     let mut runs = [[NO_FACE; POINTS]; POINTS];
     for (t, f) in faces.iter().enumerate() {
@@ -360,7 +362,7 @@ fn face_frame(points: &[DVec3], best: Option<(f64, DMat3)>) -> Option<(f64, DMat
         #[inline(always)]
         || {
             for normal in normals.iter_mut() {
-                normal.extent = extent(&column, normal.unit);
+                normal.extent = extent(&column, groups, normal.unit);
                 normal.bound = normal.extent * shadow(&area, normal.unit);
             }
         },
@@ -467,13 +469,18 @@ const LANES: usize = 4;
 /// [`POINTS`] rounded up to whole lane groups.
 const COLUMN: usize = POINTS.next_multiple_of(LANES);
 
-/// The extent `max − min` of the points (as columns, padded with one of them) along `n`.
+/// The extent `max − min` along `n` of the points in the first `groups` lane groups of
+/// `column` (padded with one of them).
+///
+/// The number of groups is a run-time value on purpose: over a constant count the loop is
+/// unrolled whole, and the unrolled code is left in scalar `f64`.
 #[inline(always)]
-fn extent(column: &[[f64; COLUMN]; 3], n: DVec3) -> f64 {
+fn extent(column: &[[f64; COLUMN]; 3], groups: usize, n: DVec3) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
-    for g in (0..COLUMN).step_by(LANES) {
+    let [xs, ys, zs] = [0, 1, 2].map(|k| &column[k].as_chunks::<LANES>().0[..groups]);
+    for ((x, y), z) in xs.iter().zip(ys).zip(zs) {
         for j in 0..LANES {
-            let h = column[0][g + j] * n.x + column[1][g + j] * n.y + column[2][g + j] * n.z;
+            let h = x[j] * n.x + y[j] * n.y + z[j] * n.z;
             lo[j] = if h < lo[j] { h } else { lo[j] };
             hi[j] = if h > hi[j] { h } else { hi[j] };
         }
