@@ -304,9 +304,7 @@ fn begun_pairs_alone_match_the_reference() {
 
 #[test]
 fn a_tower_that_comes_apart_ends_every_pair() {
-    // A stack of 64 boxes along z, each touching the next two: the scene the ended pairs'
-    // sweep takes its widest axis for (any axis gives the same pairs; this checks them,
-    // not the sweep's cost). Then the odd ones slide out, alternately to +x and −x: every
+    // A stack of 64 boxes along z, each touching the next two. Then the odd ones slide out, alternately to +x and −x: every
     // pair with an odd box ends, those of two moved odd boxes included, and only the even
     // boxes' pairs stay.
     let tower = |shift: f32| -> Vec<Aabb3> {
@@ -337,6 +335,75 @@ fn a_tower_that_comes_apart_ends_every_pair() {
     assert!(before.contains(&(1, 3)) && !now.contains(&(1, 3)));
     assert!(pairs.begun.is_empty());
     assert_eq!(as_set(&pairs.ended), &before - &now);
+}
+
+#[test]
+fn most_bodies_leaving_every_frame_end_exactly_their_pairs() {
+    // A dense crowd where about nine in ten bodies jump every frame (the regime where the
+    // ended pairs once cost a sweep that grew with the square of the movers): each frame's
+    // begun and ended pairs are the differences of the brute-force pair sets. Every third
+    // report asks for the begun pairs alone, and the next must still end exactly the pairs
+    // that overlapped at that report: the tree follows the pairs whether or not they are
+    // wanted.
+    const N: usize = 600;
+    let mut r = StdRng::seed_from_u64(68);
+    let extent: Vec<Vec3A> = (0..N)
+        .map(|_| {
+            Vec3A::new(
+                r.random_range(0.2..0.8),
+                r.random_range(0.2..0.8),
+                r.random_range(0.2..0.8),
+            )
+        })
+        .collect();
+    let mut centre: Vec<Vec3A> = (0..N)
+        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 10.0)
+        .collect();
+    let boxes = |centre: &[Vec3A]| -> Vec<Aabb3> {
+        centre
+            .iter()
+            .zip(&extent)
+            .map(|(&c, &e)| Aabb3::new(c - e, c + e))
+            .collect()
+    };
+    let member = vec![true; N];
+    let mut fat = boxes(&centre);
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    let mut before = brute_force(&fat, &member);
+    assert_eq!(as_set(&pairs.begun), before);
+    let (mut begun, mut ended, mut moved_total) = (0, 0, 0);
+    for frame in 0..40 {
+        let moved: Vec<u32> = (0..N as u32).filter(|_| r.random::<f64>() < 0.9).collect();
+        for &i in &moved {
+            let step = Vec3A::new(r.random(), r.random(), r.random()) * 1.2 - 0.6;
+            centre[i as usize] = (centre[i as usize] + step).clamp(Vec3A::ZERO, Vec3A::splat(10.0));
+        }
+        fat = boxes(&centre);
+        let mut pairs = if frame % 3 == 2 {
+            Pairs::new()
+        } else {
+            Pairs::with_ended()
+        };
+        tree.update(&moved, &fat, &mut pairs).unwrap();
+        let now = brute_force(&fat, &member);
+        if frame % 3 == 2 {
+            assert!(pairs.ended.is_empty());
+            let expected: Set = now.difference(&before).copied().collect();
+            assert_eq!(as_set(&pairs.begun), expected, "frame {frame}: begun pairs");
+        } else {
+            check(frame, &pairs, &before, &now, &tree);
+            ended += pairs.ended.len();
+        }
+        begun += pairs.begun.len();
+        moved_total += moved.len();
+        before = now;
+    }
+    assert!(
+        moved_total > 30 * N && begun > 2000 && ended > 2000,
+        "moved {moved_total}, begun {begun}, ended {ended}"
+    );
 }
 
 #[test]

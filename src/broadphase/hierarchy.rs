@@ -651,8 +651,8 @@ fn split_at_median(centres: &mut [Centre], mid: usize) {
 }
 
 /// The axis along which `lo..hi` spreads widest (spreads in `f64`, where they cannot
-/// overflow): what a build splits and the ended pairs' sweep sorts along.
-pub(crate) fn widest_axis(lo: [f32; 3], hi: [f32; 3]) -> usize {
+/// overflow): what a build splits along.
+fn widest_axis(lo: [f32; 3], hi: [f32; 3]) -> usize {
     let spread = [0, 1, 2].map(|a| f64::from(hi[a]) - f64::from(lo[a]));
     if spread[0] >= spread[1] && spread[0] >= spread[2] {
         0

@@ -66,6 +66,7 @@
 //! moved proxy must query both, which cost more than the smaller rebuilds saved.)
 
 mod hierarchy;
+mod partners;
 
 use crate::aabb::Aabb3;
 use crate::layout::BoxSource;
@@ -74,6 +75,7 @@ use core::fmt;
 use core::mem::take;
 use glam::Vec3A;
 use hierarchy::{Hierarchy, Places, Slot, overlap};
+use partners::Partners;
 
 /// Why the tree refused an input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,7 +95,7 @@ pub enum BroadphaseError {
         /// The id.
         id: u32,
     },
-    /// The memory for ids up to this one could not be allocated (the tree keeps 12 bytes
+    /// The memory for ids up to this one could not be allocated (the tree keeps 16 bytes
     /// per id up to the largest): the tree is unchanged.
     OutOfMemory {
         /// The id.
@@ -160,8 +162,9 @@ impl Pairs {
         Self::default()
     }
 
-    /// Begun and ended pairs (the ended ones cost a second query per changed proxy and a
-    /// sweep over the changed proxies' old boxes, along the axis where they spread widest).
+    /// Begun and ended pairs. The tree finds the ended ones in every report (it keeps each
+    /// proxy's partners, the proxies whose boxes overlapped its own at the last report, and
+    /// reads a changed proxy's), so asking for them costs only their list.
     #[must_use]
     pub fn with_ended() -> Self {
         Self {
@@ -239,6 +242,8 @@ pub struct DynamicTree {
     pending: Vec<Change>,
     /// Proxies refused since the last report.
     refused: Vec<u32>,
+    /// The pairs that overlapped at the last report, as each proxy's partners.
+    partners: Partners,
     len: usize,
     /// The moves and inserts since the last build.
     moves: u64,
@@ -267,6 +272,7 @@ impl Default for DynamicTree {
             mark: Vec::new(),
             pending: Vec::new(),
             refused: Vec::new(),
+            partners: Partners::default(),
             len: 0,
             moves: 0,
             rebuild_after: 16.0,
@@ -295,7 +301,8 @@ impl DynamicTree {
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for the first other NaN, infinite or inverted box,
-    /// [`BroadphaseError::IdTooLarge`] for more than `2^31 − 2` boxes, and
+    /// [`BroadphaseError::IdTooLarge`] for more than `2^31 − 2` boxes,
+    /// [`BroadphaseError::OutOfMemory`] when the per-id tables cannot be allocated, and
     /// [`BroadphaseError::Layout`] for inconsistent columns.
     pub fn from_boxes(fat: impl BoxSource<3>) -> Result<Self, BroadphaseError> {
         let len = fat.len().map_err(|_| BroadphaseError::Layout)?;
@@ -318,8 +325,15 @@ impl DynamicTree {
         for (k, (id, _)) in items.iter().enumerate() {
             mark[*id as usize] = k as u32 + 1;
         }
+        let mut partners = Partners::default();
+        partners
+            .grow(len)
+            .map_err(|_| BroadphaseError::OutOfMemory {
+                id: (len as u32).saturating_sub(1),
+            })?;
         let mut tree = Self {
             at: alloc::vec![ABSENT; len],
+            partners,
             mark,
             pending: items
                 .iter()
@@ -394,6 +408,7 @@ impl DynamicTree {
                 .try_reserve_exact(more(&self.at))
                 .and_then(|()| self.mark.try_reserve_exact(more(&self.mark)))
                 .and_then(|()| self.spare_at.try_reserve_exact(more(&self.spare_at)))
+                .and_then(|()| self.partners.grow(len))
                 .map_err(|_| BroadphaseError::OutOfMemory { id })?;
             self.at.resize(len, ABSENT);
             self.mark.resize(len, 0);
@@ -434,7 +449,7 @@ impl DynamicTree {
 
     /// Adds proxy `id` with fat box `fat`; its pairs begin at the next report (if it still
     /// has a box then: see the module docs on what a report compares). The tree's memory
-    /// grows with the largest id (12 bytes per id up to it).
+    /// grows with the largest id (16 bytes per id up to it).
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box,
@@ -742,22 +757,29 @@ impl DynamicTree {
         }
         // Queries in slot order: neighbours in the tree share their paths in the caches.
         order.sort_unstable();
-        let ended = pairs.ended_wanted;
-        let (begun, ended_pairs) = (&mut pairs.begun, &mut pairs.ended);
+        let (begun, ended) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
             hierarchy: &self.hierarchy,
+            at: &self.at,
             mark: &self.mark,
         };
         let stack = &mut self.stack;
         crate::simd::plain(
             #[inline(always)]
-            || {
-                search(&changes, &order, &view, stack, begun);
-                if ended {
-                    search_ended(&changes, &order, &view, stack, ended_pairs);
-                }
-            },
+            || search(&changes, &order, &view, stack, begun),
         );
+        // The ended pairs are found in every report, wanted or not: the partners must
+        // follow every change.
+        search_ended(&changes, &view, &self.partners, ended);
+        for &(a, b) in ended.iter() {
+            self.partners.remove(a, b);
+        }
+        for &(a, b) in begun.iter() {
+            self.partners.add(a, b);
+        }
+        if !pairs.ended_wanted {
+            ended.clear();
+        }
         for c in &changes {
             self.mark[c.id as usize] = 0;
         }
@@ -766,9 +788,10 @@ impl DynamicTree {
     }
 }
 
-/// What a report reads: the hierarchy and the change marks.
+/// What a report reads: the hierarchy, the proxies' places and the change marks.
 struct View<'a> {
     hierarchy: &'a Hierarchy,
+    at: &'a [u32],
     mark: &'a [u32],
 }
 
@@ -808,6 +831,12 @@ impl View<'_> {
             ABSENT | PARKED => Aabb3::EMPTY,
             at => self.hierarchy.get(Slot(at)),
         }
+    }
+
+    /// Proxy `id`'s box now, or the empty box.
+    #[inline(always)]
+    fn now(&self, id: u32) -> Aabb3 {
+        self.at(self.at[id as usize])
     }
 }
 
@@ -896,51 +925,27 @@ fn search(
     group.query(view, stack, &mut hit);
 }
 
-/// The ended pairs: each changed proxy's old box against the tree for the unchanged
-/// proxies (whose boxes are as they were), and a sweep over the old boxes of the changed
-/// ones for the pairs of two changed proxies.
-#[inline(always)]
+/// The ended pairs: the partners of each changed proxy (the proxies its box overlapped
+/// at the last report) whose box no longer overlaps its own. A pair of two changed proxies
+/// is taken from the smaller id's list. Each proxy's partners are read in change order, so
+/// the list is deterministic.
 fn search_ended(
     changes: &[Change],
-    order: &[u64],
     view: &View<'_>,
-    stack: &mut Vec<u64>,
+    partners: &Partners,
     ended: &mut Vec<(u32, u32)>,
 ) {
-    // The changed proxies that had a box: id, old box, new box.
-    let mut olds: Vec<(u32, Aabb3, Aabb3)> = Vec::new();
-    let mut hit = |c: &Change, new: &Aabb3, other: u32, b: &Aabb3| {
-        if view.mark[other as usize] == 0 && !overlap(new, b) {
-            ended.push((c.id.min(other), c.id.max(other)));
-        }
-    };
-    let mut group = Group::new();
-    for (c, new) in in_order(changes, order, view) {
-        let old = c.old();
-        if old.min.x > old.max.x {
+    for c in changes {
+        if partners.is_alone(c.id) {
             continue;
         }
-        olds.push((c.id, old, new));
-        if group.push(c, old, new) {
-            group.query(view, stack, &mut hit);
-        }
-    }
-    group.query(view, stack, &mut hit);
-    // Swept along the axis where the old boxes spread widest: along another, a stack or
-    // a row of bodies would put every pair in the sweep.
-    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-    for (_, old, _) in &olds {
-        (lo, hi) = (lo.min(old.min), hi.max(old.max));
-    }
-    let axis = hierarchy::widest_axis(lo.to_array(), hi.to_array());
-    olds.sort_unstable_by(|a, b| a.1.min[axis].total_cmp(&b.1.min[axis]));
-    for (k, a) in olds.iter().enumerate() {
-        for b in &olds[k + 1..] {
-            if b.1.min[axis] > a.1.max[axis] {
-                break;
+        let new = view.now(c.id);
+        for other in partners.of(c.id) {
+            if other < c.id && view.mark[other as usize] != 0 {
+                continue;
             }
-            if overlap(&a.1, &b.1) && !overlap(&a.2, &b.2) {
-                ended.push((a.0.min(b.0), a.0.max(b.0)));
+            if !overlap(&new, &view.now(other)) {
+                ended.push((c.id.min(other), c.id.max(other)));
             }
         }
     }
