@@ -10,11 +10,13 @@
 //! same subsets again as bit masks (`update-mask` and `update-aosoa-mask`, `stay` only: at
 //! 100% a mask of every bit, the path of a scene whose islands all wake).
 //!
-//! The `pipeline` groups run the broadphase example's two pipelines on parry3d's `Bvh`
-//! (`support/src/broadphase/bvh.rs`: A as rapier runs it, B fed by `Batch::update`), at 100K
-//! bodies all awake and at 1M with half asleep, stage by stage, and B again with a relative
-//! margin of 0.3 (`--relative 0.3` in the example): each sample is one frame of both
-//! pipelines, of which the measured stage's time is reported.
+//! The `pipeline` groups run the broadphase example's pipelines
+//! (`support/src/broadphase/bvh.rs`: A and B, our models on parry3d's `Bvh`, C on bvkit's
+//! `DynamicTree`, D on obvhs's `Bvh2`, R rapier's own `BroadPhaseBvh`), at 100K bodies all
+//! awake and at 1M with half asleep, stage by stage, and B again with a relative margin of
+//! 0.3 (`--relative 0.3` in the example): each sample is one frame of the pipeline, of
+//! which the measured stage's time is reported. The `frame-share` group gives C's and R's
+//! whole frame per moving body at 1%, 10%, 50% and 100% of 100K awake bodies moving.
 
 use bvkit_support::broadphase::bvh;
 use bvkit_support::broadphase::scene;
@@ -261,19 +263,29 @@ fn pipelines(c: &mut Criterion) {
             .sample_size(10)
             .warm_up_time(Duration::from_millis(1))
             .measurement_time(Duration::from_millis(1));
-        for (who, tuning, pick) in [
-            ("A", bvh::Tuning::default(), 0),
-            ("B", bvh::Tuning::default(), 1),
-            ("B-relative-0.3", relative, 1),
-            ("C", bvh::Tuning::default(), 2),
-            ("D", bvh::Tuning::default(), 3),
+        let only = |models, obvhs, rapier| bvh::Which {
+            models,
+            obvhs,
+            rapier,
+        };
+        for (who, tuning, which, pick) in [
+            ("A", bvh::Tuning::default(), only(true, false, false), 0),
+            ("B", bvh::Tuning::default(), only(true, false, false), 1),
+            ("B-relative-0.3", relative, only(true, false, false), 1),
+            ("C", bvh::Tuning::default(), only(false, false, false), 2),
+            ("D", bvh::Tuning::default(), only(false, true, false), 3),
+            ("R", bvh::Tuning::default(), only(false, false, true), 4),
         ] {
             for (k, stage) in STAGES.iter().enumerate() {
+                // R's update is one call: its frame only.
+                if pick == 4 && k + 1 < STAGES.len() {
+                    continue;
+                }
                 // Every benchmark from the same first frame, so that each one times the
                 // same frames of the walk (whose rewrites swing from 7% to 80% of the
-                // awake bodies frame to frame) and the frames of A and B compare.
+                // awake bodies frame to frame) and the frames of the pipelines compare.
                 let mut scene = scene::Scene::new(n, asleep, 256);
-                let mut pipelines = bvh::Pipelines::new(&scene, tuning);
+                let mut pipelines = bvh::Pipelines::new(&scene, tuning, which);
                 g.bench_function(format!("{who}/{stage}"), |b| {
                     b.iter_custom(|iters| {
                         let mut ms = 0.0;
@@ -292,5 +304,46 @@ fn pipelines(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench, pipelines);
+/// The frame per moved body at each share moved: 100K bodies all awake, moving 8 times as
+/// fast as the example's walk (so that about 99% of those that move leave their fat box),
+/// a share of them moving in each frame (drawn anew each frame). C's whole frame (its
+/// update, the tree's writes, upkeep and report of begun and ended pairs) and R's
+/// (rapier's `BroadPhaseBvh::update`, every awake collider modified, as rapier's pipeline
+/// passes them), in time per moving body: a flat row across the shares is a cost linear in
+/// the movers.
+fn shares(c: &mut Criterion) {
+    use criterion::SamplingMode;
+    use std::time::Duration;
+    const BODIES: usize = 100_000;
+    let mut g = c.benchmark_group("frame-share/100K-awake");
+    g.sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(1))
+        .measurement_time(Duration::from_millis(1));
+    for (who, rapier, pick) in [("C", false, 2), ("R", true, 4)] {
+        for share in [0.01, 0.1, 0.5, 1.0] {
+            let which = bvh::Which {
+                models: false,
+                obvhs: false,
+                rapier,
+            };
+            let mut scene = scene::Scene::new(BODIES, 0.0, 256).fast(8.0);
+            let mut pipelines = bvh::Pipelines::new(&scene, bvh::Tuning::default(), which);
+            g.throughput(Throughput::Elements((share * BODIES as f64) as u64));
+            g.bench_function(format!("{who}/{}%", share * 100.0), |b| {
+                b.iter_custom(|iters| {
+                    let mut ms = 0.0;
+                    for _ in 0..iters {
+                        scene.step_some(share);
+                        ms += pipelines.frame(&scene)[pick].total();
+                    }
+                    Duration::from_secs_f64(ms / 1e3)
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, pipelines, shares);
 criterion_main!(benches);

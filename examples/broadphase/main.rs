@@ -1,23 +1,32 @@
 //! The broadphase on a seeded random walk of N bodies (default 1M) over T frames (default
 //! 30), a fraction of them asleep (default 0.5) in islands of 256 consecutive bodies that
 //! sleep together (as engines put a resting pile to sleep; a fourth argument sets the island
-//! size, 1 for bodies asleep one by one at random). Two modes:
+//! size, 1 for bodies asleep one by one at random). Three modes:
 //!
-//! - `cargo run --release --features peers --example broadphase [N] [T] [asleep] [island]`: the fat-box
-//!   update against the naive path that recomputes and rewrites every box every frame, in
-//!   AoS and AoSoA; each frame prints the update's cost, the fraction of awake bodies whose
-//!   fat box moved and the fat boxes rewritten. After every frame it checks what the update
-//!   promises in each layout: every fat box contains its body's tight box.
-//! - `cargo run --release --features peers --example broadphase bvh [N] [T] [asleep] [island] [--relative R]
-//!   [--partial K]`: four whole broadphase pipelines (see `bvh.rs`), stage by stage: A and
-//!   B on parry3d's `Bvh` (rapier's, and fed by bvkit's update; the options tune B), C on
-//!   bvkit's own `broadphase::DynamicTree`, D on obvhs's `Bvh2`. Up to 20K bodies it checks
-//!   C's begun pairs every frame against a sweep, and fails on any difference.
-//!   `--rebuild-after M` and `--rebuild-frames F` tune C's upkeep (here and in `tree`).
-//! - `cargo run --release --features peers --example broadphase tree [T]`: the four
-//!   pipelines on the two scenes of issue 47 (1M bodies half asleep, 100K all awake), T
-//!   frames each (default 100, so that the means include the tree's rebuilds at 1M), C's begun pairs checked every frame against a sweep; the
-//!   last line reads `frame_vs_rapier_1m=R1 frame_vs_rapier_100k=R2 missing_pairs=M`.
+//! - `cargo run --release --features peers --example broadphase [N] [T] [asleep] [island]`:
+//!   the fat-box update against the naive path that recomputes and rewrites every box every
+//!   frame, in AoS and AoSoA; each frame prints the update's cost, the fraction of awake
+//!   bodies whose fat box moved and the fat boxes rewritten. After every frame it checks
+//!   what the update promises in each layout: every fat box contains its body's tight box.
+//! - `cargo run --release --features peers --example broadphase bvh [N] [T] [asleep] [island]`:
+//!   whole broadphase pipelines (see `support/src/broadphase/bvh.rs`), stage by stage: C,
+//!   bvkit's update into its own `broadphase::DynamicTree` (begun and ended pairs), beside R,
+//!   rapier3d 0.36.1's own `BroadPhaseBvh::update` (`rapier.rs`), and A and B, our models of
+//!   rapier's older pipeline on parry3d's `Bvh` (A as rapier ran it, B fed by bvkit's
+//!   update). Up to 20K bodies it checks every frame (C's begun and ended pairs against a
+//!   sweep, R's pairs and A's and B's trees against the exact boxes) and fails on any error;
+//!   above, every fifth frame.
+//! - `cargo run --release --features peers --example broadphase tree [T]`: C against R on
+//!   three scenes, T frames each (default 20): 1M bodies half asleep, 100K all awake, and
+//!   100K all awake moving 8 times as fast, where most bodies leave their fat box every
+//!   frame; checked every fifth frame. The last line reads `frame_vs_rapier_1m=R1
+//!   frame_vs_rapier_100k=R2 frame_vs_rapier_most_move=R3 missing_pairs=M`.
+//!
+//! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity (`bvh`),
+//! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
+//! frame at 1M), `--models` adds A and B to `tree`, `--no-rapier` leaves R out, `--check-all`
+//! checks every frame, `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
+//! `--rebuild-frames F` tune C's upkeep.
 
 use bvkit_support::broadphase::{bvh, scene};
 use bvkit_support::common;
@@ -26,6 +35,7 @@ use std::time::Instant;
 
 use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3x8, Rounding};
 
+use bvh::{Check, Which};
 use scene::Scene;
 
 fn main() {
@@ -50,47 +60,97 @@ fn main() {
         rebuild_after: option("--rebuild-after").map(|x| x as f32),
         rebuild_frames: option("--rebuild-frames").map(|x| x as u32),
     };
+    let speed = option("--speed").unwrap_or(1.0) as f32;
+    // `--name`, taken out of the positional arguments.
+    let mut flag = |name: &str| {
+        let k = args.iter().position(|a| a == name);
+        k.map(|k| args.remove(k)).is_some()
+    };
+    let obvhs = flag("--obvhs");
+    let models = flag("--models");
+    let rapier = !flag("--no-rapier");
+    let check_all = flag("--check-all");
     let arg = |k: usize, default: f64| {
         args.get(k)
             .map_or(default, |a| a.parse().expect("a number"))
     };
     let (n, frames, asleep) = (arg(0, 1e6) as usize, arg(1, 30.0) as usize, arg(2, 0.5));
     let island = (arg(3, 256.0) as usize).max(1);
-    if mode.as_deref() == Some("tree") {
-        tree(arg(0, 100.0) as usize, tuning);
-    } else if mode.is_some() {
-        // Small scenes also check C's reports every frame, and fail on any error.
-        let summary = bvh::run(n, frames, asleep, island, tuning, n <= 20_000);
-        assert_eq!(
-            summary.missing + summary.wrong,
-            0,
-            "C's begun pairs differ from the sweep's"
-        );
-    } else {
-        update_against_naive(n, frames, asleep, island);
+    match mode.as_deref() {
+        Some("tree") => {
+            let which = Which {
+                models,
+                obvhs,
+                rapier,
+            };
+            let check = if check_all {
+                Check::Every
+            } else {
+                Check::Sampled(5)
+            };
+            tree(arg(0, 20.0) as usize, tuning, which, check);
+        }
+        Some(_) => {
+            let which = Which {
+                models: true,
+                obvhs,
+                rapier,
+            };
+            let check = if check_all || n <= 20_000 {
+                Check::Every
+            } else {
+                Check::Sampled(5)
+            };
+            let scene = Scene::new(n, asleep, island).fast(speed);
+            let summary = bvh::run(scene, frames, tuning, which, check);
+            assert_eq!(
+                summary.missing + summary.wrong + summary.rapier_missing,
+                0,
+                "C's pairs differ from the sweep's, or R misses a pair"
+            );
+        }
+        None => update_against_naive(n, frames, asleep, island),
     }
 }
 
-/// The fat-box update against the naive pass, in AoS and AoSoA.
-/// The issue's two scenes through the three pipelines, C's reports checked every frame;
-/// the last line gives C's frame against A's in each and the pairs C missed.
-fn tree(frames: usize, tuning: bvh::Tuning) {
-    let big = bvh::run(1_000_000, frames, 0.5, 256, tuning, true);
-    println!();
-    let small = bvh::run(100_000, frames, 0.0, 256, tuning, true);
-    assert_eq!(
-        big.wrong + small.wrong,
-        0,
-        "C reported a pair that did not begin"
-    );
-    println!(
-        "frame_vs_rapier_1m={:.2} frame_vs_rapier_100k={:.2} missing_pairs={}",
-        big.frame[2] / big.frame[0],
-        small.frame[2] / small.frame[0],
-        big.missing + small.missing
-    );
+/// The issue's scenes through C and R (and the pipelines of `which`), checked as `check`
+/// says; the last line gives C's frame against R's in each and the pairs missed.
+fn tree(frames: usize, tuning: bvh::Tuning, which: Which, check: Check) {
+    let scenes = [
+        ("1m", Scene::new(1_000_000, 0.5, 256)),
+        ("100k", Scene::new(100_000, 0.0, 256)),
+        ("most_move", Scene::new(100_000, 0.0, 256).fast(8.0)),
+    ];
+    let mut line = Vec::new();
+    let mut missing = 0;
+    for (label, scene) in scenes {
+        let start = Instant::now();
+        let summary = bvh::run(scene, frames, tuning, which, check);
+        println!(
+            "scene {label}: C moved {:.0} proxies a frame; C's frame {:.3} µs per moved body \
+             ({:.0} s for the scene with its checks)",
+            summary.moved,
+            summary.frame[2] * 1e3 / summary.moved.max(1.0),
+            start.elapsed().as_secs_f64()
+        );
+        println!();
+        assert_eq!(
+            summary.wrong, 0,
+            "C reported a pair that did not begin or end"
+        );
+        missing += summary.missing + summary.rapier_missing;
+        if which.rapier {
+            line.push(format!(
+                "frame_vs_rapier_{label}={:.2}",
+                summary.frame[2] / summary.frame[4]
+            ));
+        }
+    }
+    line.push(format!("missing_pairs={missing}"));
+    println!("{}", line.join(" "));
 }
 
+/// The fat-box update against the naive pass, in AoS and AoSoA.
 fn update_against_naive(n: usize, frames: usize, asleep: f64, island: usize) {
     let mut scene = Scene::new(n, asleep, island);
     let (awake, mask, local) = (scene.awake, scene.mask.clone(), scene.local.clone());

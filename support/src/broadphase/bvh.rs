@@ -1,7 +1,11 @@
-//! Four broadphase pipelines on one scene, each on its own tree, frame by frame: A and B on
-//! parry3d's `Bvh`, C on bvkit's `DynamicTree`, D on obvhs's `Bvh2` (the tree avian uses).
+//! Up to five broadphase pipelines on one scene, each on its own tree, frame by frame: C on
+//! bvkit's `DynamicTree`, always, and those `Which` names: R, rapier3d 0.36.1's own
+//! `BroadPhaseBvh` (`rapier.rs`: the peer itself), A and B on parry3d's `Bvh` (our models of
+//! rapier's older pipeline, kept for what they show of bvkit's update feeding another
+//! tree), and D on obvhs's `Bvh2` (the tree avian uses).
 //!
-//! - A, as rapier runs it: every awake body's world box (`Aabb::transform_by`), each into
+//! - A, as rapier's pipeline ran it before its broadphase refitted only changed paths (a
+//!   model, not the peer): every awake body's world box (`Aabb::transform_by`), each into
 //!   the tree with `insert_or_update_partially(box, body, margin)` (a leaf changes only when
 //!   the box leaves its enlarged box), then `optimize_incremental`, `refit` (in rapier's
 //!   order: refitted before the optimisation, the tree lost pairs in `tests/pipeline.rs`)
@@ -15,9 +19,11 @@
 //! - C, bvkit's own: the same update (into its own fat boxes and moved set), then
 //!   `DynamicTree::write` of the moved proxies (the leaves, their paths enlarged: the
 //!   "leaves" column), `maintain` (a rebuild once enough has moved: "optim") and `report`
-//!   (the pairs that began, searched from the moved proxies: "pairs").
+//!   (the pairs that began and ended, searched from the moved proxies: "pairs").
 //! - D, obvhs: C's fat boxes and moved list (its box stage is C's) into `obvhs::ObvhsTree`
-//!   (see `obvhs.rs` for the upkeep obvhs advises); its pairs are the begun ones too.
+//!   (see `obvhs.rs` for the upkeep obvhs advises); its pairs are the begun ones.
+//! - R, rapier's own: one `BroadPhaseBvh::update` a frame, every awake collider modified
+//!   (its own boxes, leaves, upkeep and begun and ended pairs in one call: "frame").
 //!
 //! Two options of B's (`Tuning`) test what bvkit can take off the tree's work:
 //! - `--relative R`: B's fat boxes also grow each face by `R` times the box's half-extent
@@ -48,6 +54,7 @@ use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
 
 use super::obvhs::ObvhsTree;
+use super::rapier::Rapier;
 use super::scene::Scene;
 use crate::common::cpu;
 
@@ -87,7 +94,9 @@ pub struct Frame {
     /// `DynamicTree::maintain` says so, and reports the pairs that began.
     pub ms: [f64; 5],
     pub rewritten: usize,
+    /// The pairs that began, and those that ended (C and R report both).
     pub pairs: usize,
+    pub ended: usize,
 }
 
 impl Frame {
@@ -161,20 +170,20 @@ struct Dynamic {
     moved: Moved,
     tree: DynamicTree,
     pairs: Pairs,
-    /// The pairs of the tree's boxes at the last frame checked (the reference's).
-    checked: Option<HashSet<(u32, u32)>>,
+    /// The frame last checked and the pairs of the tree's boxes then (the reference's).
+    checked: Option<(usize, HashSet<(u32, u32)>)>,
 }
 
 fn ms(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 
-fn parry_box(b: &Aabb3) -> Aabb {
+pub(super) fn parry_box(b: &Aabb3) -> Aabb {
     Aabb::new(b.min.into(), b.max.into())
 }
 
 /// Every pair of boxes that overlap (closed boxes), by a sweep along x.
-fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
+pub(super) fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
     let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
     order.sort_by(|&a, &b| {
         boxes[a as usize]
@@ -198,32 +207,67 @@ fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
     pairs
 }
 
-/// Both pipelines' state over one scene.
+/// Which pipelines run beside C (bvkit's own, which always runs).
+#[derive(Clone, Copy, Debug)]
+pub struct Which {
+    /// A and B, the models on parry3d's `Bvh`.
+    pub models: bool,
+    /// D, obvhs's `Bvh2`.
+    pub obvhs: bool,
+    /// R, rapier's own `BroadPhaseBvh`.
+    pub rapier: bool,
+}
+
+impl Which {
+    /// Every pipeline.
+    pub const ALL: Self = Self {
+        models: true,
+        obvhs: true,
+        rapier: true,
+    };
+}
+
+/// The pipelines' state over one scene.
 pub struct Pipelines {
+    /// A's state: the local boxes, poses and world boxes in parry's form, and the tree.
+    a: Option<ModelA>,
+    batch: Batch,
+    margin: Margin,
+    /// The bodies in AoSoA blocks (the update's fastest layout; an engine that keeps its
+    /// poses packed simulates in place, so the packing is outside the timing), and the
+    /// awake mask padded to whole blocks.
+    local8: Vec<Aabb3x8>,
+    poses8: Vec<Rigid3x8>,
+    mask8: Vec<u64>,
+    /// B: its fat boxes, moved set and tree.
+    b: Option<ModelB>,
+    /// C: bvkit's update (its own fat boxes and moved set) into bvkit's tree.
+    c: Dynamic,
+    /// D: the same update's fat boxes and moved list (C's) into obvhs's `Bvh2`.
+    d: Option<ObvhsTree>,
+    /// R: rapier's own broadphase.
+    r: Option<Rapier>,
+    tuning: Tuning,
+    /// Frames run.
+    frames: usize,
+}
+
+/// Pipeline A's state.
+struct ModelA {
     local: Vec<Aabb>,
     /// A's poses, in parry's form (the engine's own, converted outside the timing).
     poses: Vec<Pose>,
     world: Vec<Aabb>,
-    a: Tree,
-    batch: Batch,
-    margin: Margin,
-    /// B's bodies in AoSoA blocks (the update's fastest layout; an engine that keeps its
-    /// poses packed simulates in place, so the packing is outside the timing), the awake
-    /// mask padded to whole blocks, and the fat boxes.
-    local8: Vec<Aabb3x8>,
-    poses8: Vec<Rigid3x8>,
-    mask8: Vec<u64>,
+    tree: Tree,
+    /// The leaves rewritten in this frame.
+    rewritten: Vec<u32>,
+}
+
+/// Pipeline B's state.
+struct ModelB {
     fat: Vec<Aabb3x8>,
     moved: Moved,
-    b: Tree,
-    /// C: bvkit's update (its own fat boxes and moved set, as B's) into bvkit's tree.
-    c: Dynamic,
-    /// D: the same update's fat boxes and moved list (C's) into obvhs's `Bvh2`.
-    d: ObvhsTree,
-    tuning: Tuning,
-    /// Frames run, and A's rewritten leaves in this one.
-    frames: usize,
-    rewritten: Vec<u32>,
+    tree: Tree,
 }
 
 fn pose(p: &bvkit::Rigid3) -> Pose {
@@ -231,17 +275,26 @@ fn pose(p: &bvkit::Rigid3) -> Pose {
 }
 
 impl Pipelines {
-    /// Both trees over the scene's first frame: every body's box.
-    pub fn new(scene: &Scene, tuning: Tuning) -> Self {
+    /// The trees over the scene's first frame: every body's box.
+    pub fn new(scene: &Scene, tuning: Tuning, which: Which) -> Self {
         let n = scene.local.len();
-        let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
-        let poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
-        let world: Vec<Aabb> = local
-            .iter()
-            .zip(&poses)
-            .map(|(b, p)| b.transform_by(p))
-            .collect();
-        let a = Tree::new(world.iter().copied(), MARGIN);
+        let a = which.models.then(|| {
+            let local: Vec<Aabb> = scene.local.iter().map(parry_box).collect();
+            let poses: Vec<Pose> = scene.poses.iter().map(pose).collect();
+            let world: Vec<Aabb> = local
+                .iter()
+                .zip(&poses)
+                .map(|(b, p)| b.transform_by(p))
+                .collect();
+            let tree = Tree::new(world.iter().copied(), MARGIN);
+            ModelA {
+                local,
+                poses,
+                world,
+                tree,
+                rewritten: Vec::new(),
+            }
+        });
         let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
         let margin = Margin::new(MARGIN, tuning.relative);
         let local8 = Aabb3x8::pack(&scene.local);
@@ -258,10 +311,14 @@ impl Pipelines {
                 &mut moved,
             )
             .expect("lengths agree");
-        let b = Tree::new(
-            Aabb3x8::unpack(&fat, n).iter().map(parry_box),
-            f32::MIN_POSITIVE,
-        );
+        let b = which.models.then(|| ModelB {
+            fat: fat.clone(),
+            moved: Moved::new(),
+            tree: Tree::new(
+                Aabb3x8::unpack(&fat, n).iter().map(parry_box),
+                f32::MIN_POSITIVE,
+            ),
+        });
         let mut mask8 = scene.mask.clone();
         mask8.resize((8 * local8.len()).div_ceil(64), 0);
         let mut tree = DynamicTree::from_boxes(&fat[..]).expect("finite fat boxes");
@@ -271,92 +328,97 @@ impl Pipelines {
         if let Some(frames) = tuning.rebuild_frames {
             tree.set_rebuild_frames(frames);
         }
-        let mut pairs = Pairs::new();
+        let mut pairs = Pairs::with_ended();
         // The first report: every overlapping pair begins.
         tree.report(&mut pairs);
-        let d = ObvhsTree::new(&Aabb3x8::unpack(&fat, n));
+        let d = which
+            .obvhs
+            .then(|| ObvhsTree::new(&Aabb3x8::unpack(&fat, n)));
         let c = Dynamic {
-            fat: fat.clone(),
-            moved: Moved::new(),
+            fat,
+            moved,
             tree,
             pairs,
             checked: None,
         };
+        let r = which.rapier.then(|| Rapier::new(scene));
         Self {
-            local,
-            poses,
-            world,
             a,
             batch,
             margin,
             local8,
             poses8,
             mask8,
-            fat,
-            moved,
             b,
             c,
             d,
+            r,
             tuning,
             frames: 0,
-            rewritten: Vec::new(),
         }
     }
 
-    /// One frame of each pipeline (A, B, C, D) on the scene's current poses.
-    pub fn frame(&mut self, scene: &Scene) -> [Frame; 4] {
+    /// One frame of each pipeline (A, B, C, D, R; those not run are zero) on the scene's
+    /// current poses.
+    pub fn frame(&mut self, scene: &Scene) -> [Frame; 5] {
         for i in scene.awake() {
-            self.poses[i] = pose(&scene.poses[i]);
             self.poses8[i / 8].set(i % 8, scene.poses[i]);
         }
         let mut fa = Frame::default();
-        let start = Instant::now();
-        for i in scene.awake() {
-            self.world[i] = self.local[i].transform_by(&self.poses[i]);
-        }
-        fa.ms[0] = ms(start);
-        let start = Instant::now();
-        self.rewritten.clear();
-        for i in scene.awake() {
-            let status = self
-                .a
-                .bvh
-                .insert_or_update_partially(self.world[i], i as u32, MARGIN);
-            if status != BvhLeafUpdateStatus::Unchanged {
-                self.rewritten.push(i as u32);
+        if let Some(a) = &mut self.a {
+            for i in scene.awake() {
+                a.poses[i] = pose(&scene.poses[i]);
             }
+            let start = Instant::now();
+            for i in scene.awake() {
+                a.world[i] = a.local[i].transform_by(&a.poses[i]);
+            }
+            fa.ms[0] = ms(start);
+            let start = Instant::now();
+            a.rewritten.clear();
+            for i in scene.awake() {
+                let status = a
+                    .tree
+                    .bvh
+                    .insert_or_update_partially(a.world[i], i as u32, MARGIN);
+                if status != BvhLeafUpdateStatus::Unchanged {
+                    a.rewritten.push(i as u32);
+                }
+            }
+            fa.rewritten = a.rewritten.len();
+            fa.ms[1] = ms(start);
+            a.tree.finish(true, &a.rewritten, &mut fa);
         }
-        fa.rewritten = self.rewritten.len();
-        fa.ms[1] = ms(start);
-        self.a.finish(true, &self.rewritten, &mut fa);
 
-        let mut fb = Frame::default();
-        let start = Instant::now();
-        self.batch
-            .update(
-                self.margin,
-                Active::Mask(&self.mask8),
-                &self.local8[..],
-                &self.poses8[..],
-                &mut self.fat[..],
-                &mut self.moved,
-            )
-            .expect("lengths agree");
-        fb.ms[0] = ms(start);
-        let start = Instant::now();
-        for &i in self.moved.indices() {
-            let (block, lane) = (i as usize / 8, i as usize % 8);
-            let fat = parry_box(&self.fat[block].get(lane));
-            self.b
-                .bvh
-                .insert_or_update_partially(fat, i, f32::MIN_POSITIVE);
-        }
-        fb.rewritten = self.moved.len();
-        fb.ms[1] = ms(start);
         self.frames += 1;
-        let partial = self.tuning.partial;
-        let whole = partial == 0 || self.frames.is_multiple_of(partial);
-        self.b.finish(whole, self.moved.indices(), &mut fb);
+        let mut fb = Frame::default();
+        if let Some(b) = &mut self.b {
+            let start = Instant::now();
+            self.batch
+                .update(
+                    self.margin,
+                    Active::Mask(&self.mask8),
+                    &self.local8[..],
+                    &self.poses8[..],
+                    &mut b.fat[..],
+                    &mut b.moved,
+                )
+                .expect("lengths agree");
+            fb.ms[0] = ms(start);
+            let start = Instant::now();
+            for &i in b.moved.indices() {
+                let (block, lane) = (i as usize / 8, i as usize % 8);
+                let fat = parry_box(&b.fat[block].get(lane));
+                b.tree
+                    .bvh
+                    .insert_or_update_partially(fat, i, f32::MIN_POSITIVE);
+            }
+            fb.rewritten = b.moved.len();
+            fb.ms[1] = ms(start);
+            let partial = self.tuning.partial;
+            let whole = partial == 0 || self.frames.is_multiple_of(partial);
+            b.tree.finish(whole, b.moved.indices(), &mut fb);
+        }
 
         let mut fc = Frame::default();
         let c = &mut self.c;
@@ -385,129 +447,172 @@ impl Pipelines {
         fc.ms[4] = ms(start);
         fc.rewritten = c.moved.len();
         fc.pairs = c.pairs.begun.len();
+        fc.ended = c.pairs.ended.len();
 
         // D reads C's update (the same call would do the same work), so its box stage is
         // C's.
         let mut fd = Frame::default();
-        fd.ms[0] = fc.ms[0];
-        let fat = &c.fat;
-        self.d.frame(
-            c.moved.indices(),
-            |i| fat[i as usize / 8].get(i as usize % 8),
-            &mut fd,
-        );
-        [fa, fb, fc, fd]
+        if let Some(d) = &mut self.d {
+            fd.ms[0] = fc.ms[0];
+            let fat = &c.fat;
+            d.frame(
+                c.moved.indices(),
+                |i| fat[i as usize / 8].get(i as usize % 8),
+                &mut fd,
+            );
+        }
+
+        // R: rapier's update does every stage in one call (its own boxes included).
+        let mut fr = Frame::default();
+        if let Some(r) = &mut self.r {
+            let f = r.frame(scene);
+            fr.ms[4] = f.ms;
+            fr.pairs = f.begun;
+            fr.ended = f.ended;
+        }
+        [fa, fb, fc, fd, fr]
     }
 
-    /// Checks C's last report against a sweep over its fat boxes: the pairs that began are
-    /// the pairs that overlap now and did not at the last check (which must be the last
-    /// frame). Returns the pairs missing from the report and the pairs it has wrongly.
+    /// Checks C's last report against a sweep over its fat boxes, when the last check was
+    /// the frame before: the pairs that began are the pairs that overlap now and did not
+    /// then, and the pairs that ended the other way round. Returns the pairs missing from
+    /// the report and the pairs it has wrongly (both zero when there is nothing to compare
+    /// with), and keeps this frame's pairs for the next check.
     pub fn check_c(&mut self, n: usize) -> (usize, usize) {
         let c = &mut self.c;
         let boxes: Vec<Aabb> = Aabb3x8::unpack(&c.fat, n).iter().map(parry_box).collect();
-        let now = overlapping(&boxes);
-        let Some(before) = c.checked.replace(now) else {
+        let now = (self.frames, overlapping(&boxes));
+        let Some((then, before)) = c.checked.replace(now) else {
             return (0, 0);
         };
-        let now = c.checked.as_ref().expect("just set");
-        let begun: HashSet<(u32, u32)> = c.pairs.begun.iter().copied().collect();
-        let expected: HashSet<(u32, u32)> = now.difference(&before).copied().collect();
+        if then + 1 != self.frames {
+            return (0, 0);
+        }
+        let now = &c.checked.as_ref().expect("just set").1;
+        let set = |pairs: &[(u32, u32)]| -> HashSet<(u32, u32)> { pairs.iter().copied().collect() };
+        let (begun, ended) = (set(&c.pairs.begun), set(&c.pairs.ended));
+        let expected_begun: HashSet<(u32, u32)> = now.difference(&before).copied().collect();
+        let expected_ended: HashSet<(u32, u32)> = before.difference(now).copied().collect();
         (
-            expected.difference(&begun).count(),
-            begun.difference(&expected).count(),
+            expected_begun.difference(&begun).count() + expected_ended.difference(&ended).count(),
+            begun.difference(&expected_begun).count() + ended.difference(&expected_ended).count(),
         )
     }
 }
 
-/// What a run measured: the mean frame of each pipeline (ms) and, over the frames checked,
-/// the pairs C's reports missed and had wrongly.
+/// What a run measured: the mean frame of each pipeline (ms; A, B, C, D, R, zero for those
+/// not run), C's mean moved proxies a frame, and, over the frames checked, the pairs C's
+/// reports missed and had wrongly and the overlapping pairs R did not hold.
 pub struct Summary {
-    pub frame: [f64; 4],
+    pub frame: [f64; 5],
+    pub moved: f64,
     pub missing: usize,
     pub wrong: usize,
+    pub rapier_missing: usize,
     pub checked: usize,
 }
 
-/// Runs the scene through the three pipelines and prints every frame. `check` compares C's
-/// reports with a sweep over its fat boxes every frame (outside the timings); up to 20K
-/// bodies, every frame also checks that A's and B's trees keep every overlapping pair.
-pub fn run(
-    n: usize,
-    frames: usize,
-    asleep: f64,
-    island: usize,
-    tuning: Tuning,
-    check: bool,
-) -> Summary {
-    let mut scene = Scene::new(n, asleep, island);
-    let mut pipelines = Pipelines::new(&scene, tuning);
+/// How often a run checks C's reports (each check is a sweep over every fat box, outside
+/// the timings): never, every frame, or every `k`-th frame (with the frame before it, whose
+/// pairs the check compares with).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Check {
+    Never,
+    Every,
+    Sampled(usize),
+}
+
+impl Check {
+    /// True when frame `f` (counted from 0) is checked, or is the one before a checked one.
+    fn runs(self, f: usize) -> bool {
+        match self {
+            Check::Never => false,
+            Check::Every => true,
+            Check::Sampled(k) => (f + 1).is_multiple_of(k) || f.is_multiple_of(k),
+        }
+    }
+}
+
+/// The labels of the pipelines, in `Pipelines::frame`'s order.
+const NAMES: [&str; 5] = ["A", "B", "C", "D", "R"];
+
+/// Runs the scene through the pipelines of `which` (and C) and prints every frame. `check`
+/// compares C's begun and ended pairs with a sweep over its fat boxes, and checks that R
+/// holds every pair of overlapping world boxes, on the frames it names; up to 20K bodies,
+/// every frame also checks that A's and B's trees keep every overlapping pair.
+pub fn run(scene: Scene, frames: usize, tuning: Tuning, which: Which, check: Check) -> Summary {
+    let mut scene = scene;
+    let n = scene.local.len();
+    let mut pipelines = Pipelines::new(&scene, tuning, which);
     // One frame before the measured ones: the first optimisation of a fresh tree costs
     // several frames' worth, once.
     scene.step();
     pipelines.frame(&scene);
-    if check {
-        pipelines.check_c(n);
-    }
-    let verify = n <= 20_000;
+    let verify = n <= 20_000 && which.models;
     let batch = pipelines.batch;
+    let run = [which.models, which.models, true, which.obvhs, which.rapier];
     println!(
-        "{n} bodies, {} awake ({:.0}% asleep, in islands of {island}), margin {MARGIN}; \
-         bvkit {:?} {:?} on {:?}; B's {tuning:?}; CPU {}",
+        "{n} bodies, {} awake, margin {MARGIN}; bvkit {:?} {:?} on {:?}; B's {tuning:?}; \
+         pipelines {}; CPU {}",
         scene.awake,
-        asleep * 100.0,
         batch.method,
         batch.rounding,
         batch.backend(),
+        NAMES
+            .iter()
+            .zip(run)
+            .filter(|(_, r)| *r)
+            .map(|(n, _)| *n)
+            .collect::<Vec<_>>()
+            .join(" "),
         cpu()
     );
-    // The columns of each pipeline: its stages in `Frame::ms` order, then the totals.
-    let columns = |first: &str| {
-        [
-            first, "leaves", "optim", "refit", "pairs", "total", "rewrit", "new",
-        ]
-        .map(|c| format!("{c:>8}"))
-        .join(" ")
-    };
-    println!(
-        "{:>5} | {} | {} | {} | {} | {:>6} {:>6} {:>6}",
-        "frame",
-        columns("A boxes"),
-        columns("B update"),
-        columns("C update"),
-        columns("D update"),
-        "B/A",
-        "C/A",
-        "D/A"
-    );
-    let mut sum = [Frame::default(); 4];
+    let mut header = format!("{:>5}", "frame");
+    for (k, name) in NAMES.iter().enumerate() {
+        if run[k] {
+            header += &format!(" | {}", columns(k, name));
+        }
+    }
+    let baseline = if which.rapier { 4 } else { 0 };
+    header += &format!(" | C/{}", NAMES[baseline]);
+    println!("{header}");
+    let mut sum = [Frame::default(); 5];
     // Over the checked frames: overlapping world boxes, and leaf pairs of one tree only.
     let (mut overlaps, mut only_a, mut only_b) = (0, 0, 0);
-    let (mut missing, mut wrong) = (0, 0);
+    let (mut missing, mut wrong, mut rapier_missing, mut checked) = (0, 0, 0, 0);
     // C's slowest upkeep and slowest frame.
     let (mut slowest_upkeep, mut slowest_frame) = (0.0f64, 0.0f64);
     for frame in 0..frames {
         scene.step();
         let f = pipelines.frame(&scene);
-        if check {
+        if check.runs(frame) {
             let (m, w) = pipelines.check_c(n);
             missing += m;
             wrong += w;
-        }
-        if verify {
             let mut tight = vec![Aabb3::EMPTY; n];
             batch
                 .transform(&scene.local, &scene.poses, &mut tight)
                 .expect("lengths agree");
-            let tight: Vec<Aabb> = tight.iter().map(parry_box).collect();
-            let exact = overlapping(&tight);
-            let (all_a, all_b) = (pipelines.a.all_pairs(), pipelines.b.all_pairs());
-            assert!(exact.is_subset(&all_a), "A misses an overlapping pair");
-            assert!(exact.is_subset(&all_b), "B misses an overlapping pair");
-            overlaps += exact.len();
-            only_a += all_a.difference(&all_b).count();
-            only_b += all_b.difference(&all_a).count();
+            if let Some(r) = &pipelines.r {
+                rapier_missing += r.missing(&tight);
+            }
+            checked += 1;
+            if verify {
+                let tight: Vec<Aabb> = tight.iter().map(parry_box).collect();
+                let exact = overlapping(&tight);
+                let (a, b) = (pipelines.a.as_mut(), pipelines.b.as_mut());
+                let (all_a, all_b) = (
+                    a.expect("models").tree.all_pairs(),
+                    b.expect("models").tree.all_pairs(),
+                );
+                assert!(exact.is_subset(&all_a), "A misses an overlapping pair");
+                assert!(exact.is_subset(&all_b), "B misses an overlapping pair");
+                overlaps += exact.len();
+                only_a += all_a.difference(&all_b).count();
+                only_b += all_b.difference(&all_a).count();
+            }
         }
-        print_frame(&frame.to_string(), &f);
+        print_frame(&frame.to_string(), &f, run, baseline);
         slowest_upkeep = slowest_upkeep.max(f[2].ms[2]);
         slowest_frame = slowest_frame.max(f[2].total());
         for (total, f) in sum.iter_mut().zip(&f) {
@@ -516,6 +621,7 @@ pub fn run(
             }
             total.rewritten += f.rewritten;
             total.pairs += f.pairs;
+            total.ended += f.ended;
         }
     }
     let mean = sum.map(|s| {
@@ -524,25 +630,33 @@ pub fn run(
             ms: s.ms.map(|x| x / f),
             rewritten: (s.rewritten as f64 / f).round() as usize,
             pairs: (s.pairs as f64 / f).round() as usize,
+            ended: (s.ended as f64 / f).round() as usize,
         }
     });
-    print_frame("mean", &mean);
+    print_frame("mean", &mean, run, baseline);
     // What the narrow phase inherits: every pair of overlapping leaves, new or not.
-    println!(
-        "overlapping leaf pairs after the last frame: A {}, B {}, C {}",
-        pipelines.a.all_pairs().len(),
-        pipelines.b.all_pairs().len(),
+    print!("overlapping leaf pairs after the last frame: C {}", {
         pipelines.c.tree.overlapping_pairs().len()
-    );
+    });
+    if let (Some(a), Some(b)) = (pipelines.a.as_mut(), pipelines.b.as_mut()) {
+        print!(
+            ", A {}, B {}",
+            a.tree.all_pairs().len(),
+            b.tree.all_pairs().len()
+        );
+    }
+    if let Some(r) = &pipelines.r {
+        print!(", R {}", r.pairs().len());
+    }
+    println!();
     if verify {
-        let f = frames.max(1) as f64;
         println!(
-            "checked every frame: each pair of overlapping world boxes ({:.0} per frame) is a \
-             leaf pair of both trees; leaf pairs of A's tree only {:.0}, of B's only {:.0} per \
-             frame",
-            overlaps as f64 / f,
-            only_a as f64 / f,
-            only_b as f64 / f
+            "checked {checked} frames: each pair of overlapping world boxes ({:.0} per frame) \
+             is a leaf pair of both trees; leaf pairs of A's tree only {:.0}, of B's only {:.0} \
+             per frame",
+            overlaps as f64 / checked.max(1) as f64,
+            only_a as f64 / checked.max(1) as f64,
+            only_b as f64 / checked.max(1) as f64
         );
     }
     println!(
@@ -550,36 +664,63 @@ pub fn run(
          average, {slowest_upkeep:.1} ms in the slowest",
         mean[2].ms[2]
     );
-    if check {
+    if check != Check::Never {
         println!(
-            "C's begun pairs against a sweep over its fat boxes, every frame: {missing} \
-             missing, {wrong} wrong"
+            "checked on {checked} of {frames} frames ({check:?}): C's begun and ended pairs \
+             against a sweep over its fat boxes: {missing} missing, {wrong} wrong; pairs of \
+             overlapping world boxes that R does not hold: {rapier_missing}"
         );
     }
     Summary {
         frame: mean.map(|m| m.total()),
+        moved: mean[2].rewritten as f64,
         missing,
         wrong,
-        checked: if check { frames } else { 0 },
+        rapier_missing,
+        checked,
     }
 }
 
-fn print_frame(label: &str, f: &[Frame; 4]) {
-    let cells = |x: &Frame| {
-        let mut c: Vec<String> = x.ms.iter().map(|v| format!("{v:>8.3}")).collect();
+/// The column heads of pipeline `k`: its stages in `Frame::ms` order and its totals (the
+/// pairs that began, or for A, B and D the pairs their traversal found from the changed
+/// leaves, and for C and R those that ended); R's update is one call, its frame only.
+fn columns(k: usize, name: &str) -> String {
+    let heads: &[&str] = match k {
+        4 => &["frame", "begun", "ended"],
+        2 => &[
+            "boxes", "leaves", "optim", "refit", "pairs", "total", "rewrit", "begun", "ended",
+        ],
+        _ => &[
+            "boxes", "leaves", "optim", "refit", "pairs", "total", "rewrit", "new",
+        ],
+    };
+    let mut c: Vec<String> = heads.iter().map(|h| format!("{h:>8}")).collect();
+    c[0] = format!("{:>8}", format!("{name} {}", heads[0]));
+    c.join(" ")
+}
+
+fn print_frame(label: &str, f: &[Frame; 5], run: [bool; 5], baseline: usize) {
+    let cells = |k: usize, x: &Frame| {
+        let mut c: Vec<String> = Vec::new();
+        if k != 4 {
+            c.extend(x.ms.iter().map(|v| format!("{v:>8.3}")));
+        }
         c.push(format!("{:>8.3}", x.total()));
-        c.push(format!("{:>8}", x.rewritten));
+        if k != 4 {
+            c.push(format!("{:>8}", x.rewritten));
+        }
         c.push(format!("{:>8}", x.pairs));
+        if k == 2 || k == 4 {
+            c.push(format!("{:>8}", x.ended));
+        }
         c.join(" ")
     };
-    println!(
-        "{label:>5} | {} | {} | {} | {} | {:>5.2}× {:>5.2}× {:>5.2}×",
-        cells(&f[0]),
-        cells(&f[1]),
-        cells(&f[2]),
-        cells(&f[3]),
-        f[1].total() / f[0].total(),
-        f[2].total() / f[0].total(),
-        f[3].total() / f[0].total()
-    );
+    let mut line = format!("{label:>5}");
+    for k in 0..5 {
+        if run[k] {
+            line += &format!(" | {}", cells(k, &f[k]));
+        }
+    }
+    line += &format!(" | {:>5.2}×", f[2].total() / f[baseline].total());
+    println!("{line}");
 }

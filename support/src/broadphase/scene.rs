@@ -16,6 +16,10 @@ pub struct Scene {
     pub mask: Vec<u64>,
     /// The number of awake bodies.
     pub awake: usize,
+    /// The factor on every velocity (1 unless `fast` set it).
+    speed: f32,
+    /// Which bodies move in `step_some`.
+    rng: StdRng,
 }
 
 impl Scene {
@@ -65,7 +69,17 @@ impl Scene {
             velocity,
             mask,
             awake,
+            speed: 1.0,
+            rng: StdRng::seed_from_u64(0x5ca1ab1e),
         }
+    }
+
+    /// The same scene with every velocity `speed` times as large: at 8, a step moves a body
+    /// by up to 0.27 units, and most awake bodies leave their fat box every frame (fast
+    /// debris, a crowd, an explosion).
+    pub fn fast(mut self, speed: f32) -> Self {
+        self.speed = speed;
+        self
     }
 
     /// The awake bodies, in ascending order.
@@ -84,13 +98,22 @@ impl Scene {
 
     /// One simulation step at 60 Hz: the awake bodies move and spin.
     pub fn step(&mut self) {
+        self.step_some(1.0);
+    }
+
+    /// One step in which each awake body moves with probability `share` (drawn anew each
+    /// step; the others keep their pose), so that a frame moves about that share of them.
+    pub fn step_some(&mut self, share: f64) {
         let spin = Quat::from_rotation_y(0.02);
-        let dt = 1.0 / 60.0;
+        let dt = self.speed / 60.0;
         for w in 0..self.mask.len() {
             let mut bits = self.mask[w];
             while bits != 0 {
                 let i = 64 * w + bits.trailing_zeros() as usize;
                 bits &= bits - 1;
+                if share < 1.0 && self.rng.random::<f64>() >= share {
+                    continue;
+                }
                 let p = &mut self.poses[i];
                 p.translation += self.velocity[i] * dt;
                 p.rotation = spin * p.rotation;
