@@ -1,7 +1,9 @@
 //! `Batch::transform_par` (feature `rayon`) against `Batch::transform`: bit-identical on
 //! every supported backend, in both modes, for every layout (and a swept pair of poses),
 //! method and rounding, with
-//! extreme inputs mixed in and lengths that leave short last parts and lane tails.
+//! extreme inputs mixed in and lengths that leave short last parts and lane tails. And
+//! `DynamicTree::update_par` against `DynamicTree::update`: the same pairs in the same order
+//! on 1 to 4 threads.
 #![cfg(feature = "rayon")]
 
 use bvkit_support::cases;
@@ -132,4 +134,76 @@ fn parallel_length_mismatch_writes_nothing() {
     let result = batch.transform_par(&local, &xfs, &mut out);
     assert!(result.is_err());
     assert!(out.iter().all(|b| b.min.x.is_nan()));
+}
+
+/// A dense crowd where about half the bodies jump every frame, a few of them to a NaN box
+/// (parked) and back, run through one tree with `update` and through others with
+/// `update_par` on pools of 1 to 4 threads: every frame's begun, ended and refused lists
+/// are the same, in the same order, and each frame's parts are many (thousands of changed
+/// proxies, 512 a part).
+#[test]
+fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() {
+    use bvkit::broadphase::{DynamicTree, Pairs};
+    use glam::Vec3A;
+    const N: usize = 12_000;
+    let mut r = rng(68);
+    let extent: Vec<Vec3A> = (0..N)
+        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 0.6 + 0.2)
+        .collect();
+    let mut centre: Vec<Vec3A> = (0..N)
+        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 40.0)
+        .collect();
+    let boxes = |centre: &[Vec3A]| -> Vec<Aabb3> {
+        centre
+            .iter()
+            .zip(&extent)
+            .map(|(&c, &e)| Aabb3::new(c - e, c + e))
+            .collect()
+    };
+    let mut fat = boxes(&centre);
+    let pools: Vec<rayon::ThreadPool> = (1..=4)
+        .map(|threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+        })
+        .collect();
+    let mut serial = DynamicTree::from_boxes(&fat).unwrap();
+    let mut parallel: Vec<DynamicTree> = pools.iter().map(|_| serial.clone()).collect();
+    let (mut begun, mut ended) = (0, 0);
+    for frame in 0..12 {
+        let moved: Vec<u32> = if frame == 0 {
+            Vec::new()
+        } else {
+            (0..N as u32).filter(|_| r.random_bool(0.5)).collect()
+        };
+        for &i in &moved {
+            let step = Vec3A::new(r.random(), r.random(), r.random()) * 1.6 - 0.8;
+            centre[i as usize] += step;
+        }
+        fat = boxes(&centre);
+        for &i in moved.iter().filter(|&&i| i % 97 == frame) {
+            fat[i as usize].min.x = f32::NAN;
+        }
+        let mut want = Pairs::with_ended();
+        serial.update(&moved, &fat, &mut want).unwrap();
+        for (tree, pool) in parallel.iter_mut().zip(&pools) {
+            let mut got = Pairs::with_ended();
+            pool.install(|| tree.update_par(&moved, &fat, &mut got))
+                .unwrap();
+            assert_eq!(
+                got,
+                want,
+                "frame {frame}, {} threads",
+                pool.current_num_threads()
+            );
+        }
+        begun += want.begun.len();
+        ended += want.ended.len();
+    }
+    assert!(
+        begun > 10_000 && ended > 5_000,
+        "begun {begun}, ended {ended}"
+    );
 }

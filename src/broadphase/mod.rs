@@ -747,6 +747,38 @@ impl DynamicTree {
     /// the last report, searched from the proxies written, inserted, removed or parked
     /// since, and the proxies refused since.
     pub fn report(&mut self, pairs: &mut Pairs) {
+        self.report_on(pairs, false);
+    }
+
+    /// [`DynamicTree::report`] on the rayon pool (feature `rayon`): the changed proxies'
+    /// searches in ordered parts, whose pairs are joined in part order, so that `pairs` is
+    /// the same, in the same order, as [`DynamicTree::report`] gives, on any number of
+    /// threads. Parts are at least 512 changed proxies, so a small report runs on the
+    /// calling thread.
+    #[cfg(feature = "rayon")]
+    pub fn report_par(&mut self, pairs: &mut Pairs) {
+        self.report_on(pairs, true);
+    }
+
+    /// [`DynamicTree::update`] with [`DynamicTree::report_par`] (feature `rayon`).
+    ///
+    /// # Errors
+    /// As [`DynamicTree::write`], before anything changes.
+    #[cfg(feature = "rayon")]
+    pub fn update_par(
+        &mut self,
+        moved: &[u32],
+        fat: impl BoxSource<3>,
+        pairs: &mut Pairs,
+    ) -> Result<(), BroadphaseError> {
+        self.write(moved, fat)?;
+        self.maintain();
+        self.report_par(pairs);
+        Ok(())
+    }
+
+    /// The report, its searches on the rayon pool when `parallel` (and the feature) say so.
+    fn report_on(&mut self, pairs: &mut Pairs, parallel: bool) {
         pairs.clear();
         core::mem::swap(&mut pairs.refused, &mut self.refused);
         let mut changes = take(&mut self.pending);
@@ -756,21 +788,55 @@ impl DynamicTree {
             order.push(u64::from(self.at[c.id as usize]) << 32 | i as u64);
         }
         // Queries in slot order: neighbours in the tree share their paths in the caches.
+        // The absent and parked proxies (places `PARKED` and `ABSENT`, the largest) come
+        // last, and have no box to query with: the placed ones are a prefix.
         order.sort_unstable();
+        let placed = order.partition_point(|&key| ((key >> 32) as u32) < PARKED);
         let (begun, ended) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
             hierarchy: &self.hierarchy,
             at: &self.at,
             mark: &self.mark,
         };
-        let stack = &mut self.stack;
-        crate::simd::plain(
-            #[inline(always)]
-            || search(&changes, &order, &view, stack, begun),
-        );
+        let partners = &self.partners;
         // The ended pairs are found in every report, wanted or not: the partners must
         // follow every change.
-        search_ended(&changes, &view, &self.partners, ended);
+        #[cfg(feature = "rayon")]
+        if parallel {
+            use rayon::prelude::*;
+            // Whole groups of queries per part, so that each part forms the serial search's
+            // groups (whose hits come in the order of their shared descent).
+            const PART: usize = 64 * hierarchy::WIDTH;
+            let found: Vec<Vec<(u32, u32)>> = order[..placed]
+                .par_chunks(PART)
+                .map(|part| {
+                    let (mut stack, mut found) = (Vec::new(), Vec::new());
+                    crate::simd::plain(
+                        #[inline(always)]
+                        || search(&changes, part, &view, &mut stack, &mut found),
+                    );
+                    found
+                })
+                .collect();
+            begun.extend(found.into_iter().flatten());
+            let found: Vec<Vec<(u32, u32)>> = changes
+                .par_chunks(PART)
+                .map(|part| {
+                    let mut found = Vec::new();
+                    search_ended(part, &view, partners, &mut found);
+                    found
+                })
+                .collect();
+            ended.extend(found.into_iter().flatten());
+        }
+        if !parallel {
+            let stack = &mut self.stack;
+            crate::simd::plain(
+                #[inline(always)]
+                || search(&changes, &order[..placed], &view, stack, begun),
+            );
+            search_ended(&changes, &view, partners, ended);
+        }
         for &(a, b) in ended.iter() {
             self.partners.remove(a, b);
         }

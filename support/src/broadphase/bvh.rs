@@ -443,6 +443,9 @@ impl Pipelines {
         c.tree.maintain();
         fc.ms[2] = ms(start);
         let start = Instant::now();
+        #[cfg(feature = "parallel")]
+        c.tree.report_par(&mut c.pairs);
+        #[cfg(not(feature = "parallel"))]
         c.tree.report(&mut c.pairs);
         fc.ms[4] = ms(start);
         fc.rewritten = c.moved.len();
@@ -533,6 +536,12 @@ impl Check {
     }
 }
 
+/// How C's report and R's update run (the `parallel` feature of this crate).
+#[cfg(feature = "parallel")]
+const THREADS: &str = "C's report and R on the rayon pool";
+#[cfg(not(feature = "parallel"))]
+const THREADS: &str = "single-threaded";
+
 /// The labels of the pipelines, in `Pipelines::frame`'s order.
 const NAMES: [&str; 5] = ["A", "B", "C", "D", "R"];
 
@@ -553,7 +562,7 @@ pub fn run(scene: Scene, frames: usize, tuning: Tuning, which: Which, check: Che
     let run = [which.models, which.models, true, which.obvhs, which.rapier];
     println!(
         "{n} bodies, {} awake, margin {MARGIN}; bvkit {:?} {:?} on {:?}; B's {tuning:?}; \
-         pipelines {}; CPU {}",
+         pipelines {}; {THREADS}; CPU {}",
         scene.awake,
         batch.method,
         batch.rounding,
