@@ -1,9 +1,10 @@
 //! `Batch::transform_par` (feature `rayon`) against `Batch::transform`: bit-identical on
 //! every supported backend, in both modes, for every layout (and a swept pair of poses),
 //! method and rounding, with
-//! extreme inputs mixed in and lengths that leave short last parts and lane tails. And
-//! `DynamicTree::update_par` against `DynamicTree::update`: the same pairs in the same order
-//! on 1 to 4 threads.
+//! extreme inputs mixed in and lengths that leave short last parts and lane tails.
+//! `Batch::update_par` against `Batch::update`: the same fat boxes and moved sets, for every
+//! kind of active set, in AoS and AoSoA. And `DynamicTree::update_par` against
+//! `DynamicTree::update`: the same pairs in the same order on 1 to 4 threads.
 #![cfg(feature = "rayon")]
 
 use bvkit_support::cases;
@@ -136,22 +137,29 @@ fn parallel_length_mismatch_writes_nothing() {
     assert!(out.iter().all(|b| b.min.x.is_nan()));
 }
 
-/// A dense crowd where about half the bodies jump every frame, a few of them to a NaN box
+/// A dense crowd where a share of the bodies jump every frame, a few of them to a NaN box
 /// (parked) and back, run through one tree with `update` and through others with
 /// `update_par` on pools of 1 to 4 threads: every frame's begun, ended and refused lists
-/// are the same, in the same order, and each frame's parts are many (thousands of changed
-/// proxies, 512 a part).
+/// are the same, in the same order. Half of 12K moving takes the report's traversal of the
+/// tree against itself (hundreds of tasks, eight a part); a twentieth of 20K, its queries
+/// (a thousand, 512 a part).
 #[test]
 fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() {
+    same_pairs_on_any_number_of_threads(12_000, 0.5);
+    same_pairs_on_any_number_of_threads(20_000, 0.05);
+}
+
+fn same_pairs_on_any_number_of_threads(n: usize, share: f64) {
     use bvkit::broadphase::{DynamicTree, Pairs};
     use glam::Vec3A;
-    const N: usize = 12_000;
     let mut r = rng(68);
-    let extent: Vec<Vec3A> = (0..N)
+    let extent: Vec<Vec3A> = (0..n)
         .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 0.6 + 0.2)
         .collect();
-    let mut centre: Vec<Vec3A> = (0..N)
-        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 40.0)
+    let mut centre: Vec<Vec3A> = (0..n)
+        .map(|_| {
+            Vec3A::new(r.random(), r.random(), r.random()) * 40.0 * (n as f32 / 12_000.0).cbrt()
+        })
         .collect();
     let boxes = |centre: &[Vec3A]| -> Vec<Aabb3> {
         centre
@@ -176,7 +184,7 @@ fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() 
         let moved: Vec<u32> = if frame == 0 {
             Vec::new()
         } else {
-            (0..N as u32).filter(|_| r.random_bool(0.5)).collect()
+            (0..n as u32).filter(|_| r.random_bool(share)).collect()
         };
         for &i in &moved {
             let step = Vec3A::new(r.random(), r.random(), r.random()) * 1.6 - 0.8;
@@ -195,7 +203,7 @@ fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() 
             assert_eq!(
                 got,
                 want,
-                "frame {frame}, {} threads",
+                "{n} boxes, frame {frame}, {} threads",
                 pool.current_num_threads()
             );
         }
@@ -206,4 +214,104 @@ fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() 
         begun > 10_000 && ended > 5_000,
         "begun {begun}, ended {ended}"
     );
+}
+
+/// Five frames of a walk where some bodies jump out of their fat boxes (one in fifty to a
+/// NaN pose), through `update` and through `update_par` on pools of 1 to 3 threads: the same
+/// fat boxes (bit for bit) and the same moved sets, for every kind of active set, in AoS
+/// and in AoSoA blocks, over a length that leaves a short last part and a lane tail.
+#[test]
+fn the_update_gives_the_same_fat_boxes_and_moved_set_on_any_number_of_threads() {
+    use bvkit::{Active, Margin, Moved, Rigid3x8};
+    use glam::{Quat, Vec3A};
+    const N: usize = 20_003;
+    let mut r = rng(69);
+    let local: Vec<Aabb3> = (0..N)
+        .map(|_| {
+            let e = Vec3A::new(r.random(), r.random(), r.random()) + 0.1;
+            Aabb3::new(-e, e)
+        })
+        .collect();
+    let mut poses: Vec<Rigid3> = (0..N)
+        .map(|_| {
+            let t = Vec3A::new(r.random(), r.random(), r.random()) * 100.0;
+            Rigid3::new(Quat::from_rotation_y(r.random()), t)
+        })
+        .collect();
+    let list: Vec<u32> = (0..N as u32).filter(|_| r.random_bool(0.3)).collect();
+    let mut mask = vec![0u64; N.div_ceil(64)];
+    for &i in &list {
+        mask[i as usize / 64] |= 1 << (i % 64);
+    }
+    let mut mask8 = mask.clone();
+    mask8.resize(N.next_multiple_of(8).div_ceil(64), 0);
+    let local8 = Aabb3x8::pack(&local);
+    let pools: Vec<rayon::ThreadPool> = (1..=3)
+        .map(|threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+        })
+        .collect();
+    let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+    let margin = Margin::new(0.05, 0.1);
+    for kind in 0..3 {
+        let (active, active8) = match kind {
+            0 => (Active::All, Active::All),
+            1 => (Active::Indices(&list), Active::Indices(&list)),
+            _ => (Active::Mask(&mask), Active::Mask(&mask8)),
+        };
+        let mut want = (vec![Aabb3::EMPTY; N], Moved::new());
+        let mut want8 = (Aabb3x8::pack(&want.0), Moved::new());
+        let mut got: Vec<_> = pools.iter().map(|_| want.clone()).collect();
+        let mut got8: Vec<_> = pools.iter().map(|_| want8.clone()).collect();
+        for frame in 0..5 {
+            if frame > 0 {
+                for (i, p) in poses.iter_mut().enumerate() {
+                    if r.random_bool(0.2) {
+                        p.translation.x += if i % 50 == frame { f32::NAN } else { 1.0 };
+                    }
+                }
+            }
+            let poses8 = Rigid3x8::pack(&poses);
+            batch
+                .update(margin, active, &local, &poses, &mut want.0, &mut want.1)
+                .unwrap();
+            batch
+                .update(
+                    margin,
+                    active8,
+                    &local8[..],
+                    &poses8[..],
+                    &mut want8.0[..],
+                    &mut want8.1,
+                )
+                .unwrap();
+            for ((pool, g), g8) in pools.iter().zip(&mut got).zip(&mut got8) {
+                pool.install(|| {
+                    batch.update_par(margin, active, &local, &poses, &mut g.0, &mut g.1)
+                })
+                .unwrap();
+                pool.install(|| {
+                    batch.update_par(
+                        margin,
+                        active8,
+                        &local8[..],
+                        &poses8[..],
+                        &mut g8.0[..],
+                        &mut g8.1,
+                    )
+                })
+                .unwrap();
+                let threads = pool.current_num_threads();
+                assert_eq!(bits(&g.0), bits(&want.0), "AoS, {kind}, {frame}, {threads}");
+                assert_eq!(g.1, want.1, "AoS moved, {kind}, {frame}, {threads}");
+                let (a, b) = (Aabb3x8::unpack(&g8.0, N), Aabb3x8::unpack(&want8.0, N));
+                assert_eq!(bits(&a), bits(&b), "AoSoA, {kind}, {frame}, {threads}");
+                assert_eq!(g8.1, want8.1, "AoSoA moved, {kind}, {frame}, {threads}");
+            }
+            assert!(want.1.len() > 500, "frame {frame}: {} moved", want.1.len());
+        }
+    }
 }

@@ -24,7 +24,8 @@
 //!
 //! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity (`bvh`),
 //! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
-//! frame at 1M), `--models` adds A and B to `tree`, `--no-rapier` leaves R out, `--check-all`
+//! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
+//! leaves R out, `--check-all`
 //! checks every frame, `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
 //! `--rebuild-frames F` tune C's upkeep.
 
@@ -68,6 +69,7 @@ fn main() {
     };
     let obvhs = flag("--obvhs");
     let models = flag("--models");
+    let no_models = flag("--no-models");
     let rapier = !flag("--no-rapier");
     let check_all = flag("--check-all");
     let arg = |k: usize, default: f64| {
@@ -92,7 +94,7 @@ fn main() {
         }
         Some(_) => {
             let which = Which {
-                models: true,
+                models: !no_models,
                 obvhs,
                 rapier,
             };

@@ -65,6 +65,18 @@ impl Moved {
         self.indices.clear();
     }
 
+    /// Adds the objects of `part`, a set over objects `start..`, as objects `start + i`;
+    /// `start` is a multiple of 64 and past every object already in the set, whose words
+    /// cover the part's.
+    #[cfg(feature = "rayon")]
+    pub(crate) fn append(&mut self, start: usize, part: &Moved) {
+        for (k, &w) in part.words.iter().enumerate() {
+            self.words[start / 64 + k] |= w;
+        }
+        self.indices
+            .extend(part.indices.iter().map(|&i| i + start as u32));
+    }
+
     /// Adds objects `i + k` for every bit `k` of `bits`; `i` is the start of a span, a
     /// multiple of its width, so the bits never straddle two words, and calls come in
     /// ascending order of their objects.

@@ -3,15 +3,22 @@
 //! The output is split into parts of whole spans (and whole AoSoA blocks); each part runs the serial batch on
 //! a window of the inputs. Every box is computed by the same code whichever part it falls
 //! in (the tail runs in one lane of the same arithmetic), so the result is bit-identical
-//! to [`Batch::transform`] on the same backend.
+//! to [`Batch::transform`] on the same backend. An update's parts start on whole words of
+//! 64 objects, so that each takes its window of the active set as it is (a mask's words, a
+//! list's entries rebased), and their moved sets join in part order into the serial one.
 
+use alloc::vec::Vec;
 use rayon::prelude::*;
 
 use super::PoseSource;
+use super::update::check_update;
 use super::{Batch, checked_len};
 use crate::aabb::Aabb3;
+use crate::batch::Moved;
+use crate::engine::Active;
 use crate::engine::{AosPoses, Poses};
 use crate::error::BatchError;
+use crate::fat::Margin;
 use crate::lane::Vector;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes};
 use crate::method::{Method, Rounding};
@@ -143,5 +150,79 @@ impl Batch {
                     part,
                 )
             })
+    }
+}
+
+impl Batch {
+    /// [`Batch::update`] on the rayon pool: the same checks, and the same fat boxes and moved
+    /// set (bit-identical, on the same backend, in either mode). Parts are at least 4096
+    /// objects, about four per thread, so a small scene runs on the calling thread.
+    ///
+    /// # Errors
+    /// As [`Batch::update`]; `fat` and `moved` are then untouched.
+    pub fn update_par<const N: usize, B, X, O>(
+        &self,
+        margin: Margin,
+        active: Active<'_>,
+        local: B,
+        poses: X,
+        mut fat: O,
+        moved: &mut Moved,
+    ) -> Result<(), BatchError>
+    where
+        B: BoxSource<N> + Sync,
+        X: PoseSource<N> + Sync,
+        O: BoxSink<N>,
+    {
+        let len = check_update(margin, active, &local, &poses, &mut fat)?;
+        let parts_wanted = 4 * rayon::current_num_threads();
+        let chunk = len
+            .div_ceil(parts_wanted)
+            .max(MIN_PART)
+            .next_multiple_of(64);
+        let parts: Vec<Moved> = fat
+            .parts(chunk)
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, part)| {
+                let start = k * chunk;
+                let len = chunk.min(len - start);
+                let mut found = Moved::new();
+                // The part's window of the active set: a list's entries in it, rebased.
+                let list: Vec<u32>;
+                let active = match active {
+                    Active::All => Active::All,
+                    Active::Mask(words) => {
+                        Active::Mask(&words[start / 64..(start + len).div_ceil(64)])
+                    }
+                    Active::Indices(ix) => {
+                        let (lo, hi) = (start as u32, (start + len) as u64);
+                        let first = ix.partition_point(|&i| i < lo);
+                        let end = ix.partition_point(|&i| u64::from(i) < hi);
+                        list = ix[first..end].iter().map(|&i| i - lo).collect();
+                        Active::Indices(&list)
+                    }
+                };
+                // The checks above passed for the whole scene, so they pass for each part:
+                // no part fails after another has written.
+                let local = Window {
+                    src: &local,
+                    start,
+                    len,
+                };
+                let poses = Window {
+                    src: &poses,
+                    start,
+                    len,
+                };
+                self.update(margin, active, local, poses, part, &mut found)
+                    .map(|()| found)
+            })
+            .collect::<Result<_, _>>()?;
+        moved.reset(len);
+        for (k, part) in parts.iter().enumerate() {
+            moved.append(k * chunk, part);
+        }
+        Ok(())
     }
 }

@@ -203,7 +203,8 @@ impl Batch {
     /// (`f64` positions, boxes relative to an `f64` origin, always rounded outward).
     /// [`Active`] restricts the update to a list or a mask of objects, so that sleeping and
     /// static objects are never written and cost little (the lane loop may read those that
-    /// share a span of 8 or 16 objects with active ones).
+    /// share a span of 8 or 16 objects with active ones). `Batch::update_par` (feature
+    /// `rayon`) runs it on the rayon pool, with the same results.
     ///
     /// ```
     /// use bvkit::{Aabb3, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
@@ -234,18 +235,7 @@ impl Batch {
         mut fat: impl BoxSink<N>,
         moved: &mut Moved,
     ) -> Result<(), BatchError> {
-        if !margin.is_valid() {
-            return Err(BatchError::InvalidMargin(margin));
-        }
-        let len = local.len()?;
-        poses.check_len(len)?;
-        BatchError::check_len("fat boxes", len, fat.len()?)?;
-        // Indices 0..len must fit in u32; compared in u64, since `u32::MAX + 1` overflows a
-        // 32-bit usize.
-        if len as u64 > u64::from(u32::MAX) + 1 {
-            return Err(BatchError::TooManyObjects(len));
-        }
-        active.check(len)?;
+        let len = check_update(margin, active, &local, &poses, &mut fat)?;
         moved.reset(len);
         let engine = Engine {
             local,
@@ -259,6 +249,30 @@ impl Batch {
         engine.run(self.backend(), !self.is_deterministic());
         Ok(())
     }
+}
+
+/// The checks of an update, before anything is written: the margin, the lengths, the
+/// objects' count and the active set. Returns the number of objects.
+pub(super) fn check_update<const N: usize>(
+    margin: Margin,
+    active: Active<'_>,
+    local: &impl BoxSource<N>,
+    poses: &impl PoseSource<N>,
+    fat: &mut impl BoxSink<N>,
+) -> Result<usize, BatchError> {
+    if !margin.is_valid() {
+        return Err(BatchError::InvalidMargin(margin));
+    }
+    let len = local.len()?;
+    poses.check_len(len)?;
+    BatchError::check_len("fat boxes", len, fat.len()?)?;
+    // Indices 0..len must fit in u32; compared in u64, since `u32::MAX + 1` overflows a
+    // 32-bit usize.
+    if len as u64 > u64::from(u32::MAX) + 1 {
+        return Err(BatchError::TooManyObjects(len));
+    }
+    active.check(len)?;
+    Ok(len)
 }
 
 /// The update's sink: each tight box compared with its fat box, the fat boxes it left
