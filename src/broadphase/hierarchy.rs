@@ -47,6 +47,10 @@ pub(crate) struct Node {
     max: [[f32; WIDTH]; 3],
     child: [u32; WIDTH],
     parent: Slot,
+    /// Bit `k` set when child `k` is a changed proxy or holds one, during a report's
+    /// traversal ([`Hierarchy::changed_pairs`]); zero otherwise. It fits in the padding of
+    /// the node's four lines.
+    dirty: u8,
 }
 
 impl Node {
@@ -56,6 +60,7 @@ impl Node {
             max: [[f32::NEG_INFINITY; WIDTH]; 3],
             child: [NONE; WIDTH],
             parent,
+            dirty: 0,
         }
     }
 
@@ -143,6 +148,19 @@ impl Child {
             c => Some(Child::Node(c)),
         }
     }
+}
+
+/// The traversal's tasks before it runs depth first: enough to share among threads.
+const FRONTIER: usize = 256;
+
+/// The task of the pairs within node `n`.
+fn task_within(n: u32) -> u64 {
+    u64::from(n) << 32 | u64::from(NONE)
+}
+
+/// The task of the pairs across slots `x` and `y`.
+fn task_across(x: Slot, y: Slot) -> u64 {
+    u64::from(x.0) << 32 | u64::from(y.0)
 }
 
 /// The half surface area of a box: the cost of visiting it, up to a constant.
@@ -408,6 +426,151 @@ impl Hierarchy {
                 self.prefetch_node(c);
                 stack.push(u64::from(c) << 8 | u64::from(down[k]));
             }
+        }
+    }
+
+    /// Marks the slots from `slot` (a changed proxy's) up to the root as holding a changed
+    /// proxy, up to the first already marked.
+    pub(crate) fn mark_changed(&mut self, mut slot: Slot) {
+        while slot.0 != NONE {
+            let node = &mut self.nodes[slot.node() as usize];
+            let bit = 1 << slot.child();
+            if node.dirty & bit != 0 {
+                return;
+            }
+            node.dirty |= bit;
+            slot = node.parent;
+        }
+    }
+
+    /// Clears the marks of [`Hierarchy::mark_changed`] from `slot` up, up to the first
+    /// already clear.
+    pub(crate) fn clear_changed(&mut self, mut slot: Slot) {
+        while slot.0 != NONE {
+            let node = &mut self.nodes[slot.node() as usize];
+            let bit = 1 << slot.child();
+            if node.dirty & bit == 0 {
+                return;
+            }
+            node.dirty &= !bit;
+            slot = node.parent;
+        }
+    }
+
+    /// True when `slot` is marked.
+    #[inline(always)]
+    fn is_changed(&self, slot: Slot) -> bool {
+        self.nodes[slot.node() as usize].dirty >> slot.child() & 1 != 0
+    }
+
+    /// The traversal's first tasks: the root's own pairs, expanded breadth first (their
+    /// pairs of proxies handed to `pair` on the way) until there are at least
+    /// [`FRONTIER`] tasks or none; each task is then run depth first by
+    /// [`Hierarchy::changed_pairs_from`], in order, on one thread or in ordered parts on
+    /// several: the pairs come in the same order either way.
+    pub(crate) fn changed_frontier(
+        &self,
+        tasks: &mut Vec<u64>,
+        mut pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
+    ) {
+        tasks.clear();
+        tasks.push(task_within(0));
+        let mut first = 0;
+        while first < tasks.len() && tasks.len() - first < FRONTIER {
+            let task = tasks[first];
+            first += 1;
+            self.expand(task, &mut pair, |t| tasks.push(t));
+        }
+        tasks.drain(..first);
+    }
+
+    /// Runs each of `tasks` depth first (see [`Hierarchy::changed_frontier`]), with `stack`
+    /// as scratch.
+    #[inline(always)]
+    pub(crate) fn changed_pairs_from(
+        &self,
+        tasks: &[u64],
+        stack: &mut Vec<u64>,
+        mut pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
+    ) {
+        for &task in tasks {
+            stack.clear();
+            stack.push(task);
+            while let Some(task) = stack.pop() {
+                self.expand(task, &mut pair, |t| stack.push(t));
+            }
+        }
+    }
+
+    /// One step of the traversal of pairs with a changed proxy: a task is a node whose
+    /// children's pairs are wanted ([`task_within`]), or two slots whose boxes overlap and
+    /// one of which is marked ([`task_across`]). Each pair of proxies is reached once, from
+    /// their lowest common node: within a node, each pair of its children whose boxes
+    /// overlap and one of which is marked; across two slots, the children of the one that
+    /// is a node (the larger, when both are) against the other, those that overlap it and
+    /// are marked or meet a marked one. Node boxes contain their children's, so no pair of
+    /// overlapping proxies is missed.
+    #[inline(always)]
+    fn expand(
+        &self,
+        task: u64,
+        pair: &mut impl FnMut(u32, &Aabb3, u32, &Aabb3),
+        mut push: impl FnMut(u64),
+    ) {
+        let (x, y) = ((task >> 32) as u32, task as u32);
+        if y == NONE {
+            let node = &self.nodes[x as usize];
+            for i in 0..WIDTH {
+                let c = node.child[i];
+                if c == NONE {
+                    continue;
+                }
+                let mut bits = node.overlaps(&Query::new(&node.get(i))) & (0xfe << i) & 0xff;
+                if node.dirty >> i & 1 == 0 {
+                    bits &= u32::from(node.dirty);
+                }
+                while bits != 0 {
+                    let j = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    push(task_across(Slot::new(x, i), Slot::new(x, j)));
+                }
+                if c & LEAF == 0 && node.dirty >> i & 1 != 0 {
+                    self.prefetch_node(c);
+                    push(task_within(c));
+                }
+            }
+            return;
+        }
+        let (sx, sy) = (Slot(x), Slot(y));
+        let (cx, cy) = (
+            self.nodes[sx.node() as usize].child[sx.child()],
+            self.nodes[sy.node() as usize].child[sy.child()],
+        );
+        let (bx, by) = (self.get(sx), self.get(sy));
+        if cx & LEAF != 0 && cy & LEAF != 0 {
+            pair(cx & !LEAF, &bx, cy & !LEAF, &by);
+            return;
+        }
+        // Descend the node side: x when y is a proxy or x is the larger node.
+        let x_down = cy & LEAF != 0 || (cx & LEAF == 0 && area(&bx) >= area(&by));
+        let (down, other, other_box) = if x_down { (cx, sy, by) } else { (cy, sx, bx) };
+        let node = &self.nodes[down as usize];
+        let mut bits = node.overlaps(&Query::new(&other_box));
+        if !self.is_changed(other) {
+            bits &= u32::from(node.dirty);
+        }
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if node.child[j] == NONE {
+                continue;
+            }
+            let s = Slot::new(down, j);
+            push(if x_down {
+                task_across(s, other)
+            } else {
+                task_across(other, s)
+            });
         }
     }
 

@@ -180,6 +180,11 @@ impl Pairs {
     }
 }
 
+/// A report traverses the tree against itself once at least one proxy in this many
+/// changed, and queries each changed proxy's box otherwise (as rapier reinserts below a
+/// sixteenth changed and updates in place above).
+const TRAVERSE_FROM: usize = 16;
+
 /// Where a proxy is: nowhere, parked, or a slot.
 const ABSENT: u32 = u32::MAX;
 const PARKED: u32 = u32::MAX - 1;
@@ -259,9 +264,10 @@ pub struct DynamicTree {
     replay: Vec<u32>,
     /// [`DynamicTree::set_rebuild_frames`].
     rebuild_frames: u32,
-    /// Scratch: the order of the changes, the query stack.
+    /// Scratch: the order of the changes, the query stack, the traversal's tasks.
     order: Vec<u64>,
     stack: Vec<u64>,
+    tasks: Vec<u64>,
 }
 
 impl Default for DynamicTree {
@@ -283,6 +289,7 @@ impl Default for DynamicTree {
             rebuild_frames: 32,
             order: Vec::new(),
             stack: Vec::new(),
+            tasks: Vec::new(),
         }
     }
 }
@@ -792,6 +799,16 @@ impl DynamicTree {
         // last, and have no box to query with: the placed ones are a prefix.
         order.sort_unstable();
         let placed = order.partition_point(|&key| ((key >> 32) as u32) < PARKED);
+        // Once a sixteenth of the proxies or more changed, one traversal of the tree against
+        // itself, restricted to the changed proxies' paths, shares the descents that their
+        // queries would each repeat.
+        let traverse = placed * TRAVERSE_FROM >= self.len;
+        let mut tasks = take(&mut self.tasks);
+        if traverse {
+            for &key in &order[..placed] {
+                self.hierarchy.mark_changed(Slot((key >> 32) as u32));
+            }
+        }
         let (begun, ended) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
             hierarchy: &self.hierarchy,
@@ -801,23 +818,43 @@ impl DynamicTree {
         let partners = &self.partners;
         // The ended pairs are found in every report, wanted or not: the partners must
         // follow every change.
+        if traverse {
+            view.hierarchy.changed_frontier(&mut tasks, |a, ba, b, bb| {
+                view.begun(&changes, (a, ba), (b, bb), begun)
+            });
+        }
         #[cfg(feature = "rayon")]
         if parallel {
             use rayon::prelude::*;
             // Whole groups of queries per part, so that each part forms the serial search's
-            // groups (whose hits come in the order of their shared descent).
+            // groups (whose hits come in the order of their shared descent); the traversal's
+            // tasks in parts of eight.
             const PART: usize = 64 * hierarchy::WIDTH;
-            let found: Vec<Vec<(u32, u32)>> = order[..placed]
-                .par_chunks(PART)
-                .map(|part| {
-                    let (mut stack, mut found) = (Vec::new(), Vec::new());
-                    crate::simd::plain(
-                        #[inline(always)]
-                        || search(&changes, part, &view, &mut stack, &mut found),
-                    );
-                    found
-                })
-                .collect();
+            let found: Vec<Vec<(u32, u32)>> = if traverse {
+                tasks
+                    .par_chunks(8)
+                    .map(|part| {
+                        let (mut stack, mut found) = (Vec::new(), Vec::new());
+                        crate::simd::plain(
+                            #[inline(always)]
+                            || view.changed_pairs(&changes, part, &mut stack, &mut found),
+                        );
+                        found
+                    })
+                    .collect()
+            } else {
+                order[..placed]
+                    .par_chunks(PART)
+                    .map(|part| {
+                        let (mut stack, mut found) = (Vec::new(), Vec::new());
+                        crate::simd::plain(
+                            #[inline(always)]
+                            || search(&changes, part, &view, &mut stack, &mut found),
+                        );
+                        found
+                    })
+                    .collect()
+            };
             begun.extend(found.into_iter().flatten());
             let found: Vec<Vec<(u32, u32)>> = changes
                 .par_chunks(PART)
@@ -831,12 +868,25 @@ impl DynamicTree {
         }
         if !parallel {
             let stack = &mut self.stack;
-            crate::simd::plain(
-                #[inline(always)]
-                || search(&changes, &order[..placed], &view, stack, begun),
-            );
+            if traverse {
+                crate::simd::plain(
+                    #[inline(always)]
+                    || view.changed_pairs(&changes, &tasks, stack, begun),
+                );
+            } else {
+                crate::simd::plain(
+                    #[inline(always)]
+                    || search(&changes, &order[..placed], &view, stack, begun),
+                );
+            }
             search_ended(&changes, &view, partners, ended);
         }
+        if traverse {
+            for &key in &order[..placed] {
+                self.hierarchy.clear_changed(Slot((key >> 32) as u32));
+            }
+        }
+        self.tasks = tasks;
         for &(a, b) in ended.iter() {
             self.partners.remove(a, b);
         }
@@ -903,6 +953,42 @@ impl View<'_> {
     #[inline(always)]
     fn now(&self, id: u32) -> Aabb3 {
         self.at(self.at[id as usize])
+    }
+
+    /// Adds the pair of proxies `a` and `b` (with their boxes now, which overlap, and one
+    /// of them changed) to `begun` when their boxes at the last report did not overlap: a
+    /// changed proxy's then is its change's old box, an unchanged one's is its box now.
+    #[inline(always)]
+    fn begun(
+        &self,
+        changes: &[Change],
+        (a, ba): (u32, &Aabb3),
+        (b, bb): (u32, &Aabb3),
+        begun: &mut Vec<(u32, u32)>,
+    ) {
+        let then = |id: u32, now: &Aabb3| match self.mark[id as usize] {
+            0 => *now,
+            m => changes[m as usize - 1].old(),
+        };
+        if !overlap(&then(a, ba), &then(b, bb)) {
+            begun.push((a.min(b), a.max(b)));
+        }
+    }
+
+    /// The traversal's `tasks` run depth first ([`Hierarchy::changed_pairs_from`]), their
+    /// pairs that began into `begun`.
+    #[inline(always)]
+    fn changed_pairs(
+        &self,
+        changes: &[Change],
+        tasks: &[u64],
+        stack: &mut Vec<u64>,
+        begun: &mut Vec<(u32, u32)>,
+    ) {
+        self.hierarchy
+            .changed_pairs_from(tasks, stack, |a, ba, b, bb| {
+                self.begun(changes, (a, ba), (b, bb), begun)
+            });
     }
 }
 
