@@ -25,8 +25,7 @@
 //! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity (`bvh`),
 //! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
 //! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
-//! leaves R out, `--check-all`
-//! checks every frame, `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
+//! leaves R out, `--check-all` checks every frame and `--no-check` none (for profiling), `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
 //! `--rebuild-frames F` tune C's upkeep.
 
 use bvkit_support::broadphase::{bvh, scene};
@@ -72,6 +71,7 @@ fn main() {
     let no_models = flag("--no-models");
     let rapier = !flag("--no-rapier");
     let check_all = flag("--check-all");
+    let no_check = flag("--no-check");
     let arg = |k: usize, default: f64| {
         args.get(k)
             .map_or(default, |a| a.parse().expect("a number"))
@@ -85,10 +85,10 @@ fn main() {
                 obvhs,
                 rapier,
             };
-            let check = if check_all {
-                Check::Every
-            } else {
-                Check::Sampled(5)
+            let check = match (check_all, no_check) {
+                (true, _) => Check::Every,
+                (_, true) => Check::Never,
+                _ => Check::Sampled(5),
             };
             tree(arg(0, 20.0) as usize, tuning, which, check);
         }
@@ -98,10 +98,10 @@ fn main() {
                 obvhs,
                 rapier,
             };
-            let check = if check_all || n <= 20_000 {
-                Check::Every
-            } else {
-                Check::Sampled(5)
+            let check = match (check_all || n <= 20_000, no_check) {
+                (_, true) => Check::Never,
+                (true, _) => Check::Every,
+                _ => Check::Sampled(5),
             };
             let scene = Scene::new(n, asleep, island).fast(speed);
             let summary = bvh::run(scene, frames, tuning, which, check);
