@@ -48,7 +48,7 @@ pub(crate) struct Node {
     child: [u32; WIDTH],
     parent: Slot,
     /// Bit `k` set when child `k` is a changed proxy or holds one, during a report's
-    /// traversal ([`Hierarchy::changed_pairs`]); zero otherwise. It fits in the padding of
+    /// traversal ([`Hierarchy::changed_frontier`]); zero otherwise. It fits in the padding of
     /// the node's four lines.
     dirty: u8,
 }
@@ -185,6 +185,9 @@ pub(crate) struct Hierarchy {
     /// pages in again.
     centres: Vec<Centre>,
     tasks: Vec<Task>,
+    /// The nodes [`Hierarchy::mark_changed`] marked since the last
+    /// [`Hierarchy::clear_marks`].
+    marked: Vec<u32>,
 }
 
 impl Default for Hierarchy {
@@ -194,6 +197,7 @@ impl Default for Hierarchy {
             free: Vec::new(),
             centres: Vec::new(),
             tasks: Vec::new(),
+            marked: Vec::new(),
         }
     }
 }
@@ -438,22 +442,18 @@ impl Hierarchy {
             if node.dirty & bit != 0 {
                 return;
             }
+            if node.dirty == 0 {
+                self.marked.push(slot.node());
+            }
             node.dirty |= bit;
             slot = node.parent;
         }
     }
 
-    /// Clears the marks of [`Hierarchy::mark_changed`] from `slot` up, up to the first
-    /// already clear.
-    pub(crate) fn clear_changed(&mut self, mut slot: Slot) {
-        while slot.0 != NONE {
-            let node = &mut self.nodes[slot.node() as usize];
-            let bit = 1 << slot.child();
-            if node.dirty & bit == 0 {
-                return;
-            }
-            node.dirty &= !bit;
-            slot = node.parent;
+    /// Clears every mark of [`Hierarchy::mark_changed`]: a write per marked node.
+    pub(crate) fn clear_marks(&mut self) {
+        for n in self.marked.drain(..) {
+            self.nodes[n as usize].dirty = 0;
         }
     }
 

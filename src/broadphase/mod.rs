@@ -789,26 +789,32 @@ impl DynamicTree {
         pairs.clear();
         core::mem::swap(&mut pairs.refused, &mut self.refused);
         let mut changes = take(&mut self.pending);
-        let mut order = take(&mut self.order);
-        order.clear();
-        for (i, c) in changes.iter().enumerate() {
-            order.push(u64::from(self.at[c.id as usize]) << 32 | i as u64);
-        }
-        // Queries in slot order: neighbours in the tree share their paths in the caches.
-        // The absent and parked proxies (places `PARKED` and `ABSENT`, the largest) come
-        // last, and have no box to query with: the placed ones are a prefix.
-        order.sort_unstable();
-        let placed = order.partition_point(|&key| ((key >> 32) as u32) < PARKED);
         // Once a sixteenth of the proxies or more changed, one traversal of the tree against
         // itself, restricted to the changed proxies' paths, shares the descents that their
-        // queries would each repeat.
-        let traverse = placed * TRAVERSE_FROM >= self.len;
-        let mut tasks = take(&mut self.tasks);
+        // queries would each repeat; it needs those paths marked, in any order.
+        let traverse = changes.len() * TRAVERSE_FROM >= self.len;
+        let placed = |at: u32| at != ABSENT && at != PARKED;
+        let mut order = take(&mut self.order);
+        order.clear();
         if traverse {
-            for &key in &order[..placed] {
-                self.hierarchy.mark_changed(Slot((key >> 32) as u32));
+            for c in &changes {
+                let at = self.at[c.id as usize];
+                if placed(at) {
+                    self.hierarchy.mark_changed(Slot(at));
+                }
             }
+        } else {
+            // Queries in slot order: neighbours in the tree share their paths in the
+            // caches. The absent and parked proxies (places `PARKED` and `ABSENT`, the
+            // largest) come last, and have no box to query with: they are cut off.
+            for (i, c) in changes.iter().enumerate() {
+                order.push(u64::from(self.at[c.id as usize]) << 32 | i as u64);
+            }
+            order.sort_unstable();
+            let queried = order.partition_point(|&key| placed((key >> 32) as u32));
+            order.truncate(queried);
         }
+        let mut tasks = take(&mut self.tasks);
         let (begun, ended) = (&mut pairs.begun, &mut pairs.ended);
         let view = View {
             hierarchy: &self.hierarchy,
@@ -843,7 +849,7 @@ impl DynamicTree {
                     })
                     .collect()
             } else {
-                order[..placed]
+                order
                     .par_chunks(PART)
                     .map(|part| {
                         let (mut stack, mut found) = (Vec::new(), Vec::new());
@@ -876,16 +882,12 @@ impl DynamicTree {
             } else {
                 crate::simd::plain(
                     #[inline(always)]
-                    || search(&changes, &order[..placed], &view, stack, begun),
+                    || search(&changes, &order, &view, stack, begun),
                 );
             }
             search_ended(&changes, &view, partners, ended);
         }
-        if traverse {
-            for &key in &order[..placed] {
-                self.hierarchy.clear_changed(Slot((key >> 32) as u32));
-            }
-        }
+        self.hierarchy.clear_marks();
         self.tasks = tasks;
         for &(a, b) in ended.iter() {
             self.partners.remove(a, b);
