@@ -337,6 +337,32 @@ fn a_tower_that_comes_apart_ends_every_pair() {
     assert_eq!(as_set(&pairs.ended), &before - &now);
 }
 
+/// A crowd of `n` boxes of half-extents 0.2 to 0.8 with centres in a cube of `side` units.
+struct Crowd {
+    extent: Vec<Vec3A>,
+    centre: Vec<Vec3A>,
+}
+
+impl Crowd {
+    fn new(r: &mut StdRng, n: usize, side: f32) -> Self {
+        let extent = (0..n)
+            .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 0.6 + 0.2)
+            .collect();
+        let centre = (0..n)
+            .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * side)
+            .collect();
+        Self { extent, centre }
+    }
+
+    fn boxes(&self) -> Vec<Aabb3> {
+        self.centre
+            .iter()
+            .zip(&self.extent)
+            .map(|(&c, &e)| Aabb3::new(c - e, c + e))
+            .collect()
+    }
+}
+
 #[test]
 fn most_bodies_leaving_every_frame_end_exactly_their_pairs() {
     // A dense crowd where about nine in ten bodies jump every frame (the regime where the
@@ -347,27 +373,9 @@ fn most_bodies_leaving_every_frame_end_exactly_their_pairs() {
     // wanted.
     const N: usize = 600;
     let mut r = StdRng::seed_from_u64(68);
-    let extent: Vec<Vec3A> = (0..N)
-        .map(|_| {
-            Vec3A::new(
-                r.random_range(0.2..0.8),
-                r.random_range(0.2..0.8),
-                r.random_range(0.2..0.8),
-            )
-        })
-        .collect();
-    let mut centre: Vec<Vec3A> = (0..N)
-        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 10.0)
-        .collect();
-    let boxes = |centre: &[Vec3A]| -> Vec<Aabb3> {
-        centre
-            .iter()
-            .zip(&extent)
-            .map(|(&c, &e)| Aabb3::new(c - e, c + e))
-            .collect()
-    };
+    let mut crowd = Crowd::new(&mut r, N, 10.0);
     let member = vec![true; N];
-    let mut fat = boxes(&centre);
+    let mut fat = crowd.boxes();
     let mut tree = DynamicTree::from_boxes(&fat).unwrap();
     let mut pairs = Pairs::with_ended();
     tree.update(&[], &fat, &mut pairs).unwrap();
@@ -378,9 +386,10 @@ fn most_bodies_leaving_every_frame_end_exactly_their_pairs() {
         let moved: Vec<u32> = (0..N as u32).filter(|_| r.random::<f64>() < 0.9).collect();
         for &i in &moved {
             let step = Vec3A::new(r.random(), r.random(), r.random()) * 1.2 - 0.6;
-            centre[i as usize] = (centre[i as usize] + step).clamp(Vec3A::ZERO, Vec3A::splat(10.0));
+            let c = &mut crowd.centre[i as usize];
+            *c = (*c + step).clamp(Vec3A::ZERO, Vec3A::splat(10.0));
         }
-        fat = boxes(&centre);
+        fat = crowd.boxes();
         let mut pairs = if frame % 3 == 2 {
             Pairs::new()
         } else {
@@ -413,21 +422,9 @@ fn few_movers_among_many_take_the_queries_and_agree_with_brute_force() {
     // frame, every report against brute force.
     const N: usize = 2000;
     let mut r = StdRng::seed_from_u64(16);
-    let extent: Vec<Vec3A> = (0..N)
-        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 0.6 + 0.2)
-        .collect();
-    let mut centre: Vec<Vec3A> = (0..N)
-        .map(|_| Vec3A::new(r.random(), r.random(), r.random()) * 16.0)
-        .collect();
-    let boxes = |centre: &[Vec3A]| -> Vec<Aabb3> {
-        centre
-            .iter()
-            .zip(&extent)
-            .map(|(&c, &e)| Aabb3::new(c - e, c + e))
-            .collect()
-    };
+    let mut crowd = Crowd::new(&mut r, N, 16.0);
     let member = vec![true; N];
-    let mut fat = boxes(&centre);
+    let mut fat = crowd.boxes();
     let mut tree = DynamicTree::from_boxes(&fat).unwrap();
     let mut pairs = Pairs::with_ended();
     tree.update(&[], &fat, &mut pairs).unwrap();
@@ -438,9 +435,9 @@ fn few_movers_among_many_take_the_queries_and_agree_with_brute_force() {
         moved.sort_unstable();
         moved.dedup();
         for &i in &moved {
-            centre[i as usize] += Vec3A::new(r.random(), r.random(), r.random()) * 3.0 - 1.5;
+            crowd.centre[i as usize] += Vec3A::new(r.random(), r.random(), r.random()) * 3.0 - 1.5;
         }
-        fat = boxes(&centre);
+        fat = crowd.boxes();
         tree.update(&moved, &fat, &mut pairs).unwrap();
         let now = brute_force(&fat, &member);
         check(frame, &pairs, &before, &now, &tree);

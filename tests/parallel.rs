@@ -169,14 +169,7 @@ fn same_pairs_on_any_number_of_threads(n: usize, share: f64) {
             .collect()
     };
     let mut fat = boxes(&centre);
-    let pools: Vec<rayon::ThreadPool> = (1..=4)
-        .map(|threads| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-        })
-        .collect();
+    let pools = pools(4);
     let mut serial = DynamicTree::from_boxes(&fat).unwrap();
     let mut parallel: Vec<DynamicTree> = pools.iter().map(|_| serial.clone()).collect();
     let (mut begun, mut ended) = (0, 0);
@@ -246,14 +239,7 @@ fn the_update_gives_the_same_fat_boxes_and_moved_set_on_any_number_of_threads() 
     let mut mask8 = mask.clone();
     mask8.resize(N.next_multiple_of(8).div_ceil(64), 0);
     let local8 = Aabb3x8::pack(&local);
-    let pools: Vec<rayon::ThreadPool> = (1..=3)
-        .map(|threads| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-        })
-        .collect();
+    let pools = pools(3);
     let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
     let margin = Margin::new(0.05, 0.1);
     for kind in 0..3 {
@@ -314,4 +300,16 @@ fn the_update_gives_the_same_fat_boxes_and_moved_set_on_any_number_of_threads() 
             assert!(want.1.len() > 500, "frame {frame}: {} moved", want.1.len());
         }
     }
+}
+
+/// Thread pools of 1 to `most` threads.
+fn pools(most: usize) -> Vec<rayon::ThreadPool> {
+    (1..=most)
+        .map(|threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+        })
+        .collect()
 }

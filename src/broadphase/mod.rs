@@ -618,9 +618,20 @@ impl DynamicTree {
         fat: impl BoxSource<3>,
         pairs: &mut Pairs,
     ) -> Result<(), BroadphaseError> {
+        self.update_on(moved, fat, pairs, false)
+    }
+
+    /// A frame, its report on the rayon pool when `parallel` (and the feature) say so.
+    fn update_on(
+        &mut self,
+        moved: &[u32],
+        fat: impl BoxSource<3>,
+        pairs: &mut Pairs,
+        parallel: bool,
+    ) -> Result<(), BroadphaseError> {
         self.write(moved, fat)?;
         self.maintain();
-        self.report(pairs);
+        self.report_on(pairs, parallel);
         Ok(())
     }
 
@@ -778,10 +789,7 @@ impl DynamicTree {
         fat: impl BoxSource<3>,
         pairs: &mut Pairs,
     ) -> Result<(), BroadphaseError> {
-        self.write(moved, fat)?;
-        self.maintain();
-        self.report_par(pairs);
-        Ok(())
+        self.update_on(moved, fat, pairs, true)
     }
 
     /// The report, its searches on the rayon pool when `parallel` (and the feature) say so.
