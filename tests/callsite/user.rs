@@ -20,6 +20,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut tree = DynamicTree::from_boxes(&fat)?;
     let mut pairs = Pairs::new();
     tree.update(moved.indices(), &fat, &mut pairs)?;
-    println!("{} moved, {} pairs; {:?}", moved.len(), pairs.begun.len(), world[7]);
+    println!(
+        "{} moved, {} pairs; {:?}",
+        moved.len(),
+        pairs.begun.len(),
+        world[7]
+    );
     Ok(())
 }
