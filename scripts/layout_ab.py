@@ -22,13 +22,14 @@ after/before of each, and each side's spread over its runs.
 
 Usage:
     python3 scripts/layout_ab.py BEFORE_DIR AFTER_DIR BENCH [FILTER] [--runs N] [--first-seed S]
-                                 [--add EARLIER.json ...] [--json OUT]
+                                 [--add EARLIER.json ...] [--json OUT] [--criterion "ARGS"]
 
 BEFORE_DIR and AFTER_DIR are checkouts of the two trees (`git worktree add ../before REV`).
 BENCH is a criterion bench target (`speed`, `classes`, `broadphase`); FILTER is criterion's
 regular expression (default: every row). The seeds are S, S+1, ... (default 1), so a later
 call with `--first-seed` draws new layouts, and `--add` joins the runs that earlier calls saved
-with `--json` (of the same two trees) to this call's runs before the table. Needs the x86_64
+with `--json` (of the same two trees) to this call's runs before the table; `--criterion` passes
+options to each run (shorter warm-up and measurement times for many rows). Needs the x86_64
 Linux default linker, rust-lld. Run nothing else meanwhile.
 
 With 5 or more runs a side, the median over runs also keeps a row's figure when one or two
@@ -73,10 +74,10 @@ def relink(command, exe, seed):
     subprocess.run(["bash", "-c", command], check=True)
 
 
-def run(exe, filt):
+def run(exe, filt, criterion=()):
     """Runs one bench binary once; returns {row: criterion's median in ns}."""
     with tempfile.TemporaryDirectory() as home:
-        subprocess.run([str(exe), "--bench", "--noplot", filt], check=True,
+        subprocess.run([str(exe), "--bench", "--noplot", *criterion, filt], check=True,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                        env=dict(os.environ, CRITERION_HOME=home))
         rows = {}
@@ -104,6 +105,8 @@ def main():
     p.add_argument("--first-seed", type=int, default=1)
     p.add_argument("--add", type=pathlib.Path, nargs="*", default=[])
     p.add_argument("--json", type=pathlib.Path)
+    p.add_argument("--criterion", default="",
+                   help="options for criterion, e.g. \"--warm-up-time 1 --measurement-time 2\"")
     a = p.parse_args()
 
     work = pathlib.Path(tempfile.mkdtemp(prefix="layout_ab_"))
@@ -116,7 +119,7 @@ def main():
     runs = {"before": [], "after": []}
     for seed in seeds:
         for side in ("before", "after") if seed % 2 else ("after", "before"):
-            runs[side].append(run(work / f"{side}{seed}", a.filter))
+            runs[side].append(run(work / f"{side}{seed}", a.filter, shlex.split(a.criterion)))
             print(f"{side} run {seed} done", file=sys.stderr, flush=True)
     shutil.rmtree(work)
     if a.json:

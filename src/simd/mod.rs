@@ -202,19 +202,46 @@ pub(crate) fn dispatch_groups<J: GroupJob>(backend: Backend, job: J) {
     }
 }
 
-// The features enabled here are those of `Backend::Avx2.features()` (a test checks they agree).
+// Each `#[target_feature]` wrapper lives in a module of its own: rustc compiles each module's
+// instances in a codegen unit of its own, so that the wrappers' loops (most of the library's
+// code) are optimised on several cores rather than one after another in a single unit.
+
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn run_avx2_pairs<J: GroupJob>(job: J) {
-    job.run::<2, group::AvxPair>();
+use {avx2::run_avx2, pairs::run_avx2_pairs, quads::run_avx512_quads};
+
+#[cfg(target_arch = "x86_64")]
+mod pairs {
+    use super::{GroupJob, group};
+
+    // The features enabled here are those of `Backend::Avx2.features()` (a test checks they
+    // agree).
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn run_avx2_pairs<J: GroupJob>(job: J) {
+        job.run::<2, group::AvxPair>();
+    }
 }
 
-// The features enabled here are those of `Backend::Avx512.features()` (a test checks they
-// agree).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx2,fma")]
-fn run_avx512_quads<J: GroupJob>(job: J) {
-    job.run::<4, group::Avx512Quad>();
+mod quads {
+    use super::{GroupJob, group};
+
+    // The features enabled here are those of `Backend::Avx512.features()` (a test checks
+    // they agree).
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    pub(super) fn run_avx512_quads<J: GroupJob>(job: J) {
+        job.run::<4, group::Avx512Quad>();
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{Job, LaneArray};
+
+    // The features enabled here are `Backend::Avx2.features()` (a test checks they agree).
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn run_avx2<J: Job, L: LaneArray>(job: J) {
+        job.run::<L>();
+    }
 }
 
 /// A job that ignores the lane type: plain array code, compiled with the features of the
@@ -240,13 +267,6 @@ pub(crate) fn plain<T: Default>(f: impl FnOnce() -> T) -> T {
     let mut out = T::default();
     dispatch(Backend::detect(), false, Plain { f, out: &mut out });
     out
-}
-
-// The features enabled here are `Backend::Avx2.features()` (a test checks they agree).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn run_avx2<J: Job, L: LaneArray>(job: J) {
-    job.run::<L>();
 }
 
 /// Orders every non-temporal store before the stores that follow ([`LaneArray::store_streaming`]

@@ -5,34 +5,14 @@
 //! bottom-up pass (refit) is a reverse scan, and the left child of a node that is not a
 //! primitive is the next node.
 
-use super::nodes::{Ref, Store};
+use super::nodes::{PrimBox, Ref, Store};
 use alloc::vec;
 use alloc::vec::Vec;
 
 /// Bins per axis.
 const BINS: usize = 16;
 
-/// A primitive's box, exact `f32` faces.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct PrimBox {
-    pub min: [f32; 3],
-    pub max: [f32; 3],
-}
-
 impl PrimBox {
-    pub(crate) const EMPTY: PrimBox = PrimBox {
-        min: [f32::INFINITY; 3],
-        max: [f32::NEG_INFINITY; 3],
-    };
-
-    #[inline]
-    pub(crate) fn union(&self, o: &PrimBox) -> PrimBox {
-        PrimBox {
-            min: core::array::from_fn(|k| self.min[k].min(o.min[k])),
-            max: core::array::from_fn(|k| self.max[k].max(o.max[k])),
-        }
-    }
-
     /// Half the surface area, in `f64` (no overflow).
     fn half_area(&self) -> f64 {
         let d: [f64; 3] =

@@ -17,10 +17,31 @@
 //! ([`Quantized::quantize`]). Reading a box back rounds at most once per coordinate
 //! (`origin + step·c`); the query pad covers that rounding.
 
-use super::build::PrimBox;
 use crate::num::{ceil, pow2, pow2_at_least, round, round_up, two_sum};
 use alloc::vec::Vec;
 use glam::{DVec3, Vec3A};
+
+/// A primitive's box, exact `f32` faces.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimBox {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+impl PrimBox {
+    pub(crate) const EMPTY: PrimBox = PrimBox {
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+    };
+
+    #[inline]
+    pub(crate) fn union(&self, o: &PrimBox) -> PrimBox {
+        PrimBox {
+            min: core::array::from_fn(|k| self.min[k].min(o.min[k])),
+            max: core::array::from_fn(|k| self.max[k].max(o.max[k])),
+        }
+    }
+}
 
 /// A child: a node index, or a primitive id with the top bit set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

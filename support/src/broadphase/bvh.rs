@@ -53,9 +53,11 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhLeafUpdateStatus, BvhWorkspace};
 
+pub use super::Frame;
 use super::obvhs::ObvhsTree;
 use super::rapier::Rapier;
 use super::scene::Scene;
+use super::{overlapping, parry_box};
 use crate::common::cpu;
 
 /// The margin both pipelines give a box when its leaf is rewritten (B's relative part is
@@ -84,25 +86,6 @@ pub struct Tuning {
     pub rebuild_after: Option<f32>,
     /// C's `DynamicTree::set_rebuild_frames`, where given.
     pub rebuild_frames: Option<u32>,
-}
-
-/// The milliseconds of a frame's stages, and what they did.
-#[derive(Default, Clone, Copy)]
-pub struct Frame {
-    /// World or fat boxes, tree leaves, optimisation, refit, pairs. C writes its leaves
-    /// and enlarges their paths in one step (its "leaves"), optimises by rebuilding when
-    /// `DynamicTree::maintain` says so, and reports the pairs that began.
-    pub ms: [f64; 5],
-    pub rewritten: usize,
-    /// The pairs that began, and those that ended (C and R report both).
-    pub pairs: usize,
-    pub ended: usize,
-}
-
-impl Frame {
-    pub fn total(&self) -> f64 {
-        self.ms.iter().sum()
-    }
 }
 
 impl Tree {
@@ -176,35 +159,6 @@ struct Dynamic {
 
 fn ms(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
-}
-
-pub(super) fn parry_box(b: &Aabb3) -> Aabb {
-    Aabb::new(b.min.into(), b.max.into())
-}
-
-/// Every pair of boxes that overlap (closed boxes), by a sweep along x.
-pub(super) fn overlapping(boxes: &[Aabb]) -> HashSet<(u32, u32)> {
-    let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
-    order.sort_by(|&a, &b| {
-        boxes[a as usize]
-            .mins
-            .x
-            .total_cmp(&boxes[b as usize].mins.x)
-    });
-    let mut pairs = HashSet::new();
-    for (k, &a) in order.iter().enumerate() {
-        let ba = &boxes[a as usize];
-        for &b in &order[k + 1..] {
-            let bb = &boxes[b as usize];
-            if bb.mins.x > ba.maxs.x {
-                break;
-            }
-            if ba.intersects(bb) {
-                pairs.insert((a.min(b), a.max(b)));
-            }
-        }
-    }
-    pairs
 }
 
 /// Which pipelines run beside C (bvkit's own, which always runs).

@@ -61,7 +61,7 @@ use ::obvhs::ploc::rebuild::compute_rebuild_path_flags;
 use ::obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use bvkit::Aabb3;
 
-use super::bvh::Frame;
+use super::Frame;
 
 /// Below this share of the proxies moved, the moved leaves are reinserted (avian's default).
 const REINSERT_BELOW: f64 = 0.15;

@@ -228,8 +228,8 @@ impl Rapier {
     /// Checks that every pair of bodies whose world boxes overlap (closed boxes, one box per
     /// body, e.g. the Outward tight boxes) is in [`Self::pairs`]; returns the number missing.
     pub fn missing(&self, world: &[Aabb3]) -> usize {
-        let boxes: Vec<_> = world.iter().map(super::bvh::parry_box).collect();
-        super::bvh::overlapping(&boxes)
+        let boxes: Vec<_> = world.iter().map(super::parry_box).collect();
+        super::overlapping(&boxes)
             .iter()
             .filter(|pair| !self.pairs.contains(pair))
             .count()
