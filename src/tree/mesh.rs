@@ -7,8 +7,7 @@ use core::fmt;
 use glam::{DVec3, Vec3, Vec3A};
 
 use super::build;
-use super::nodes::PrimBox;
-use super::nodes::{Compact, Layout, PRIMITIVE, Ref};
+use super::nodes::{Compact, Layout, PRIMITIVE, PrimBox, Ref};
 use super::triangle::Soup;
 use crate::aabb::Aabb3;
 
