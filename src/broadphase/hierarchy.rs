@@ -47,9 +47,13 @@ pub(crate) struct Node {
     max: [[f32; WIDTH]; 3],
     child: [u32; WIDTH],
     parent: Slot,
-    /// Bit `k` set when child `k` is a changed proxy or holds one, during a report's
-    /// traversal ([`Hierarchy::changed_frontier`]); zero otherwise. It fits in the padding of
-    /// the node's four lines.
+    /// The marks' epoch: `dirty` holds marks only while it equals the hierarchy's
+    /// [`Hierarchy::epoch`], so that one increment clears every mark.
+    epoch: u32,
+    /// Bit `k` set when child `k` is a changed proxy or holds one
+    /// ([`Hierarchy::mark_changed`], [`Hierarchy::set`]), read by a report's traversal
+    /// ([`Hierarchy::changed_frontier`]). With the epoch it fits in the padding of the
+    /// node's four lines.
     dirty: u8,
 }
 
@@ -60,8 +64,25 @@ impl Node {
             max: [[f32::NEG_INFINITY; WIDTH]; 3],
             child: [NONE; WIDTH],
             parent,
+            epoch: 0,
             dirty: 0,
         }
+    }
+
+    /// The marks of this node in `epoch`.
+    #[inline(always)]
+    fn marks(&self, epoch: u32) -> u8 {
+        if self.epoch == epoch { self.dirty } else { 0 }
+    }
+
+    /// Marks child `k` in `epoch`; true when the node had no mark before (so its own slot
+    /// above is not marked yet).
+    #[inline(always)]
+    fn mark(&mut self, k: usize, epoch: u32) -> bool {
+        let before = self.marks(epoch);
+        self.epoch = epoch;
+        self.dirty = before | 1 << k;
+        before == 0
     }
 
     /// Child `k`'s box.
@@ -185,9 +206,8 @@ pub(crate) struct Hierarchy {
     /// pages in again.
     centres: Vec<Centre>,
     tasks: Vec<Task>,
-    /// The nodes [`Hierarchy::mark_changed`] marked since the last
-    /// [`Hierarchy::clear_marks`].
-    marked: Vec<u32>,
+    /// The epoch of the marks in use: a node's marks count only in it ([`Node::epoch`]).
+    epoch: u32,
 }
 
 impl Default for Hierarchy {
@@ -197,7 +217,7 @@ impl Default for Hierarchy {
             free: Vec::new(),
             centres: Vec::new(),
             tasks: Vec::new(),
-            marked: Vec::new(),
+            epoch: 1,
         }
     }
 }
@@ -281,11 +301,35 @@ impl Hierarchy {
 
     /// Writes the box of the proxy in `slot`, and enlarges the slots above it until one
     /// already contains the box (Box2D's early exit): a slot then still contains its node's
-    /// union, with room left where a child shrank or left, until the next build.
+    /// union, with room left where a child shrank or left, until the next build. The slot
+    /// is marked changed as [`Hierarchy::mark_changed`] marks it, on the same walk up, while
+    /// the nodes are in the cache.
     #[inline(always)]
     pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
-        self.nodes[slot.node() as usize].set(slot.child(), b);
-        self.enlarge_above(slot.node(), b);
+        let epoch = self.epoch;
+        let node = &mut self.nodes[slot.node() as usize];
+        node.set(slot.child(), b);
+        let mut mark = node.mark(slot.child(), epoch);
+        let mut enlarge = true;
+        let mut n = slot.node();
+        while enlarge || mark {
+            let parent = self.nodes[n as usize].parent;
+            if parent.0 == NONE {
+                return;
+            }
+            let p = &mut self.nodes[parent.node() as usize];
+            if enlarge {
+                let old = p.get(parent.child());
+                enlarge = !(old.min.cmple(b.min).all() && b.max.cmple(old.max).all());
+                if enlarge {
+                    p.set(parent.child(), &old.union(b));
+                }
+            }
+            if mark {
+                mark = p.mark(parent.child(), epoch);
+            }
+            n = parent.node();
+        }
     }
 
     /// Enlarges the slots above node `n` to contain `b`, up to the first that does.
@@ -434,33 +478,39 @@ impl Hierarchy {
     }
 
     /// Marks the slots from `slot` (a changed proxy's) up to the root as holding a changed
-    /// proxy, up to the first already marked.
+    /// proxy, up to the first node already marked (whose slot above is).
     pub(crate) fn mark_changed(&mut self, mut slot: Slot) {
         while slot.0 != NONE {
             let node = &mut self.nodes[slot.node() as usize];
-            let bit = 1 << slot.child();
-            if node.dirty & bit != 0 {
+            if !node.mark(slot.child(), self.epoch) {
                 return;
             }
-            if node.dirty == 0 {
-                self.marked.push(slot.node());
-            }
-            node.dirty |= bit;
             slot = node.parent;
         }
     }
 
-    /// Clears every mark of [`Hierarchy::mark_changed`]: a write per marked node.
+    /// Clears every mark at once: a new epoch. When the epoch wraps, every node's is reset
+    /// first, so that no old mark can count again.
     pub(crate) fn clear_marks(&mut self) {
-        for n in self.marked.drain(..) {
-            self.nodes[n as usize].dirty = 0;
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            for node in &mut self.nodes {
+                node.epoch = 0;
+            }
+            self.epoch = 1;
         }
+    }
+
+    /// The marks of node `n`.
+    #[inline(always)]
+    fn marks(&self, n: u32) -> u8 {
+        self.nodes[n as usize].marks(self.epoch)
     }
 
     /// True when `slot` is marked.
     #[inline(always)]
     fn is_changed(&self, slot: Slot) -> bool {
-        self.nodes[slot.node() as usize].dirty >> slot.child() & 1 != 0
+        self.marks(slot.node()) >> slot.child() & 1 != 0
     }
 
     /// The traversal's first tasks: the root's own pairs, expanded breadth first (their
@@ -520,21 +570,22 @@ impl Hierarchy {
         let (x, y) = ((task >> 32) as u32, task as u32);
         if y == NONE {
             let node = &self.nodes[x as usize];
+            let dirty = node.marks(self.epoch);
             for i in 0..WIDTH {
                 let c = node.child[i];
                 if c == NONE {
                     continue;
                 }
                 let mut bits = node.overlaps(&Query::new(&node.get(i))) & (0xfe << i) & 0xff;
-                if node.dirty >> i & 1 == 0 {
-                    bits &= u32::from(node.dirty);
+                if dirty >> i & 1 == 0 {
+                    bits &= u32::from(dirty);
                 }
                 while bits != 0 {
                     let j = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     push(task_across(Slot::new(x, i), Slot::new(x, j)));
                 }
-                if c & LEAF == 0 && node.dirty >> i & 1 != 0 {
+                if c & LEAF == 0 && dirty >> i & 1 != 0 {
                     self.prefetch_node(c);
                     push(task_within(c));
                 }
@@ -557,7 +608,7 @@ impl Hierarchy {
         let node = &self.nodes[down as usize];
         let mut bits = node.overlaps(&Query::new(&other_box));
         if !self.is_changed(other) {
-            bits &= u32::from(node.dirty);
+            bits &= u32::from(node.marks(self.epoch));
         }
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;

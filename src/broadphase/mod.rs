@@ -247,6 +247,10 @@ pub struct DynamicTree {
     pending: Vec<Change>,
     /// Proxies refused since the last report.
     refused: Vec<u32>,
+    /// True while every change in `pending` has its path marked in `hierarchy` (each write
+    /// marks its own): no insert, remove, park or unpark since the last report, and no
+    /// rebuild taking over, which move proxies between slots.
+    paths_marked: bool,
     /// The pairs that overlapped at the last report, as each proxy's partners.
     partners: Partners,
     len: usize,
@@ -278,6 +282,7 @@ impl Default for DynamicTree {
             mark: Vec::new(),
             pending: Vec::new(),
             refused: Vec::new(),
+            paths_marked: true,
             partners: Partners::default(),
             len: 0,
             moves: 0,
@@ -346,6 +351,8 @@ impl DynamicTree {
                 .iter()
                 .map(|(id, _)| Change::new(*id, &Aabb3::EMPTY))
                 .collect(),
+            // Every proxy is a change, its path not marked.
+            paths_marked: false,
             len: items.len(),
             ..Self::default()
         };
@@ -564,6 +571,7 @@ impl DynamicTree {
         }
         core::mem::swap(&mut self.hierarchy, &mut self.spare);
         core::mem::swap(&mut self.at, &mut self.spare_at);
+        self.paths_marked = false;
         self.replay = replay;
         self.rebuilding = None;
         true
@@ -580,6 +588,7 @@ impl DynamicTree {
     /// Notes that proxy `id` is inserted, removed, parked or unparked, for the rebuild under
     /// way (which brings such proxies up to date when its build is done).
     fn restructured(&mut self, id: u32) {
+        self.paths_marked = false;
         if self.rebuilding.is_some() {
             self.replay.push(id);
         }
@@ -799,16 +808,20 @@ impl DynamicTree {
         let mut changes = take(&mut self.pending);
         // Once a sixteenth of the proxies or more changed, one traversal of the tree against
         // itself, restricted to the changed proxies' paths, shares the descents that their
-        // queries would each repeat; it needs those paths marked, in any order.
+        // queries would each repeat; it needs those paths marked, in any order. The writes
+        // marked theirs, unless proxies moved between slots since.
         let traverse = changes.len() * TRAVERSE_FROM >= self.len;
         let placed = |at: u32| at != ABSENT && at != PARKED;
         let mut order = take(&mut self.order);
         order.clear();
         if traverse {
-            for c in &changes {
-                let at = self.at[c.id as usize];
-                if placed(at) {
-                    self.hierarchy.mark_changed(Slot(at));
+            if !self.paths_marked {
+                self.hierarchy.clear_marks();
+                for c in &changes {
+                    let at = self.at[c.id as usize];
+                    if placed(at) {
+                        self.hierarchy.mark_changed(Slot(at));
+                    }
                 }
             }
         } else {
@@ -896,6 +909,7 @@ impl DynamicTree {
             search_ended(&changes, &view, partners, ended);
         }
         self.hierarchy.clear_marks();
+        self.paths_marked = true;
         self.tasks = tasks;
         for &(a, b) in ended.iter() {
             self.partners.remove(a, b);
