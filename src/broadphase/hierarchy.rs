@@ -876,3 +876,65 @@ fn widest_axis(lo: [f32; 3], hi: [f32; 3]) -> usize {
         2
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each proxy's slot, as the hierarchy moves it.
+    struct Slots(Vec<u32>);
+
+    impl Places for Slots {
+        fn place(&mut self, id: u32, slot: Slot) {
+            self.0[id as usize] = slot.0;
+        }
+    }
+
+    /// True when `slot` and every slot above it are marked.
+    fn path_marked(h: &Hierarchy, mut slot: Slot) -> bool {
+        while slot.0 != NONE {
+            if !h.is_changed(slot) {
+                return false;
+            }
+            slot = h.nodes[slot.node() as usize].parent;
+        }
+        true
+    }
+
+    fn any_mark(h: &Hierarchy) -> bool {
+        (0..h.nodes.len() as u32).any(|n| h.marks(n) != 0)
+    }
+
+    /// A write marks its path up to the root; a clear drops every mark at once; and when the
+    /// epoch wraps, a mark left from the epoch it wraps to does not count again.
+    #[test]
+    fn writes_mark_their_paths_and_a_clear_drops_every_mark_even_when_the_epoch_wraps() {
+        let mut h = Hierarchy::default();
+        let mut slots = Slots(alloc::vec![NONE; 100]);
+        let b = |x: f32| Aabb3::new(Vec3A::splat(x), Vec3A::splat(x + 1.0));
+        for id in 0..100 {
+            h.insert(id, &b(id as f32 * 0.5), &mut slots);
+        }
+        let slot = |id: usize| Slot(slots.0[id]);
+        assert!(h.nodes.len() > 8 && !any_mark(&h));
+        // A box far away: the write enlarges every slot above it, and marks them.
+        h.set(slot(5), &b(500.0));
+        assert!(path_marked(&h, slot(5)) && !h.is_changed(slot(6)));
+        h.clear_marks();
+        assert!(!any_mark(&h));
+        // A mark made in epoch 1, then left (at a proxy whose node is not on proxy 7's
+        // path): the epoch counts up to the last before it wraps, where proxy 7's path is
+        // marked; the clear that wraps it back to 1 must drop both.
+        assert_ne!(slot(90).node(), slot(7).node());
+        h.epoch = 1;
+        h.set(slot(90), &b(44.0));
+        h.epoch = u32::MAX;
+        h.mark_changed(slot(7));
+        assert!(path_marked(&h, slot(7)) && !h.is_changed(slot(90)));
+        h.clear_marks();
+        assert_eq!(h.epoch, 1);
+        assert!(!any_mark(&h));
+        h.set(slot(90), &b(44.5));
+        assert!(path_marked(&h, slot(90)) && !h.is_changed(slot(7)));
+    }
+}
