@@ -306,12 +306,19 @@ impl Hierarchy {
     /// the nodes are in the cache.
     #[inline(always)]
     pub(crate) fn set(&mut self, slot: Slot, b: &Aabb3) {
-        let epoch = self.epoch;
         let node = &mut self.nodes[slot.node() as usize];
         node.set(slot.child(), b);
-        let mut mark = node.mark(slot.child(), epoch);
+        let mark = node.mark(slot.child(), self.epoch);
+        self.enlarge_above(slot.node(), b, mark);
+    }
+
+    /// Enlarges the slots above node `n` to contain `b`, up to the first that does, and
+    /// when `mark` (node `n` took its first mark) marks them, up to the first node already
+    /// marked: one walk up for both.
+    #[inline(always)]
+    fn enlarge_above(&mut self, mut n: u32, b: &Aabb3, mut mark: bool) {
+        let epoch = self.epoch;
         let mut enlarge = true;
-        let mut n = slot.node();
         while enlarge || mark {
             let parent = self.nodes[n as usize].parent;
             if parent.0 == NONE {
@@ -332,23 +339,6 @@ impl Hierarchy {
         }
     }
 
-    /// Enlarges the slots above node `n` to contain `b`, up to the first that does.
-    fn enlarge_above(&mut self, mut n: u32, b: &Aabb3) {
-        loop {
-            let parent = self.nodes[n as usize].parent;
-            if parent.0 == NONE {
-                return;
-            }
-            let p = &mut self.nodes[parent.node() as usize];
-            let old = p.get(parent.child());
-            if old.min.cmple(b.min).all() && b.max.cmple(old.max).all() {
-                return;
-            }
-            p.set(parent.child(), &old.union(b));
-            n = parent.node();
-        }
-    }
-
     /// Adds proxy `id` with box `b`: down from the root, into the first node with a free
     /// slot, else into the child whose box grows least in area (a proxy there becomes a
     /// node of two). Returns its slot.
@@ -360,7 +350,7 @@ impl Hierarchy {
                 let node = &mut self.nodes[n as usize];
                 node.set(k, b);
                 node.child[k] = Child::Proxy(id).encode();
-                self.enlarge_above(n, b);
+                self.enlarge_above(n, b, false);
                 let slot = Slot::new(n, k);
                 places.place(id, slot);
                 return slot;

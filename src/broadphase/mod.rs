@@ -585,8 +585,9 @@ impl DynamicTree {
         (then != ABSENT && then != PARKED).then_some(Slot(then))
     }
 
-    /// Notes that proxy `id` is inserted, removed, parked or unparked, for the rebuild under
-    /// way (which brings such proxies up to date when its build is done).
+    /// Notes that proxy `id` is inserted, removed, parked or unparked: proxies may have
+    /// moved between slots, so the report marks the changed paths again, and the rebuild
+    /// under way brings such proxies up to date when its build is done.
     fn restructured(&mut self, id: u32) {
         self.paths_marked = false;
         if self.rebuilding.is_some() {
