@@ -10,6 +10,7 @@ use crate::aabb::Aabb3;
 use crate::engine::{Active, AosCall, AosSink, Engine, PoseList, Poses, Redo, Sink, Tight};
 use crate::error::BatchError;
 use crate::fat::Margin;
+use crate::kernel::gather;
 use crate::lane::Vector;
 use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
@@ -429,9 +430,15 @@ fn fat_aos(call: AosCall<'_>, sink: Fat<'_, &mut [Aabb3]>) {
 
 /// The fat sink on the AoS loop.
 impl AosSink for Fat<'_, &mut [Aabb3]> {
-    /// Eight objects at a time: the tight boxes and the mask of those that left their fat
-    /// boxes, then a loop over its set bits. A branch per object would mispredict on every
-    /// object a walk moves at random; the loop mispredicts once per eight.
+    /// Sixty-four objects at a time: their tight boxes from the transform's own loop
+    /// ([`Tight::boxes`]), then per group of `W` the test against the fat boxes in
+    /// registers ([`BoxGroup::le_xyz`]), and where a box of the group left its fat box, the
+    /// group's fat boxes stored with the grown boxes picked in ([`BoxGroup::pick`]): the
+    /// others keep their bits. A branch per object would mispredict on every object a walk
+    /// moves at random. The objects are recorded once per 64. (Eight at a time, with the
+    /// test and the growth one box after the other, the update of 16K bodies, all awake,
+    /// ran at 1.83x the naive rewrite, against 1.65x now, Intel Xeon with AVX-512: the
+    /// kernel is most of both.)
     #[inline(always)]
     fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
@@ -440,30 +447,61 @@ impl AosSink for Fat<'_, &mut [Aabb3]> {
         poses: impl PoseList<'p, T>,
         tight: Tight<P, W>,
     ) {
+        debug_assert_eq!(start % 64, 0, "a run starts on a word of the moved set");
+        let every = u32::MAX >> (32 - W);
         let fat = &mut self.fat[start..start + local.len()];
-        for (c, (local, fat)) in local.chunks(8).zip(fat.chunks_mut(8)).enumerate() {
-            let mut boxes = [Aabb3::EMPTY; 8];
-            tight.boxes(local, poses, start + 8 * c, &mut boxes[..local.len()]);
+        let mut chunk = [Aabb3::EMPTY; 64];
+        for (c, (local, fat)) in local.chunks(64).zip(fat.chunks_mut(64)).enumerate() {
+            let first = start + 64 * c;
+            let tight_boxes = &mut chunk[..local.len()];
+            tight.boxes(local, poses, first, tight_boxes);
             let mut left = 0;
-            for (k, (b, f)) in boxes.iter().zip(&*fat).enumerate() {
-                left |= u64::from(!crate::fat::inside_aabb3(b, f)) << k;
+            let groups = tight_boxes.chunks_exact(W).zip(fat.chunks_exact_mut(W));
+            for (g, (tight, fat)) in groups.enumerate() {
+                let (min, max) = (
+                    P::join(gather(|k| tight[k].min)),
+                    P::join(gather(|k| tight[k].max)),
+                );
+                let fat_min = P::join(gather(|k| fat[k].min));
+                let fat_max = P::join(gather(|k| fat[k].max));
+                let inside = P::le_xyz(fat_min, min) & P::le_xyz(max, fat_max);
+                if inside != every {
+                    let (grown_min, grown_max) =
+                        self.margin.grow::<P, 1>(Vector([min]), Vector([max]));
+                    let min = P::pick(inside, fat_min, grown_min.0[0]).parts();
+                    let max = P::pick(inside, fat_max, grown_max.0[0]).parts();
+                    for (k, fat) in fat.iter_mut().enumerate() {
+                        *fat = Aabb3 {
+                            min: min[k],
+                            max: max[k],
+                        };
+                    }
+                }
+                left |= u64::from(!inside & every) << (g * W);
             }
-            let mut bits = left;
-            while bits != 0 {
-                let k = bits.trailing_zeros() as usize;
-                fat[k] = boxes[k].fattened(self.margin);
-                bits &= bits - 1;
+            for k in local.len() - local.len() % W..local.len() {
+                left |= u64::from(!keep(&mut fat[k], tight_boxes[k], self.margin)) << k;
             }
-            self.moved.record(start + 8 * c, left);
+            self.moved.record(first, left);
         }
     }
     #[inline(always)]
     fn one(&mut self, i: usize, tight: Aabb3) {
-        if !crate::fat::inside_aabb3(&tight, &self.fat[i]) {
-            self.fat[i] = tight.fattened(self.margin);
+        if !keep(&mut self.fat[i], tight, self.margin) {
             self.moved.record(i, 1);
         }
     }
+}
+
+/// One object of the AoS loop: true when its tight box lies inside its fat box; otherwise
+/// the fat box becomes the tight box fattened.
+#[inline(always)]
+fn keep(fat: &mut Aabb3, tight: Aabb3, margin: Margin) -> bool {
+    let inside = crate::fat::inside_aabb3(&tight, fat);
+    if !inside {
+        *fat = tight.fattened(margin);
+    }
+    inside
 }
 
 #[cfg(test)]

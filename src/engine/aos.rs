@@ -30,8 +30,9 @@ const SPAN: usize = 64;
 /// A sink the AoS loop can write: the lane loop's sink over AoS 3D boxes, which also takes
 /// their tight boxes from the single-box kernel ([`Tight`]), several at a time or one.
 pub(crate) trait AosSink: Sink<3> {
-    /// Objects `start..start + local.len()`, every one active: object `start + k`'s tight
-    /// box is `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
+    /// Objects `start..start + local.len()`, every one active, `start` a multiple of 64
+    /// (a whole span of the walk, or object 0): object `start + k`'s tight box is
+    /// `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
     fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
         &mut self,
         start: usize,

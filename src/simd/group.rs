@@ -29,6 +29,27 @@ pub(crate) trait BoxGroup<const W: usize>: Axes {
     fn all_xyz(m: Self::Mask) -> bool;
     /// Every component set.
     fn all_set() -> Self::Mask;
+    /// Bit `k` set where part `k` of `a` is `<=` part `k` of `b` in `x`, `y` and `z`
+    /// (ordered, as glam's `cmple`: false for NaN).
+    fn le_xyz(a: Self, b: Self) -> u32;
+    /// Part `k` of `a` where bit `k` of `parts` is set, of `b` elsewhere.
+    fn pick(parts: u32, a: Self, b: Self) -> Self;
+}
+
+/// Bit `k` set where bits `4k`, `4k + 1` and `4k + 2` of `m` are (`x`, `y`, `z` of part
+/// `k` in a mask of four bits per part), for parts `0..4`.
+#[inline(always)]
+fn whole_parts(m: u32) -> u32 {
+    let x = m & m >> 1 & m >> 2 & 0x1111;
+    (x | x >> 3 | x >> 6 | x >> 9) & 0xF
+}
+
+/// Bit `k` of `parts` spread to bits `4k..4k + 4`, for parts `0..4`: the inverse of
+/// [`whole_parts`], a mask of four bits per part.
+#[inline(always)]
+fn spread_parts(parts: u32) -> u32 {
+    let x = parts & 1 | (parts & 2) << 3 | (parts & 4) << 6 | (parts & 8) << 9;
+    x * 0xF
 }
 
 /// Two `Vec3A` side by side: the pair on any target (two SSE registers on x86-64), whose
@@ -134,6 +155,17 @@ impl BoxGroup<2> for Two {
     fn all_set() -> (BVec3A, BVec3A) {
         (BVec3A::TRUE, BVec3A::TRUE)
     }
+    #[inline(always)]
+    fn le_xyz(a: Self, b: Self) -> u32 {
+        <Vec3A as BoxGroup<1>>::le_xyz(a.0, b.0) | <Vec3A as BoxGroup<1>>::le_xyz(a.1, b.1) << 1
+    }
+    #[inline(always)]
+    fn pick(parts: u32, a: Self, b: Self) -> Self {
+        Two(
+            <Vec3A as BoxGroup<1>>::pick(parts, a.0, b.0),
+            <Vec3A as BoxGroup<1>>::pick(parts >> 1, a.1, b.1),
+        )
+    }
 }
 
 /// One box per `Vec3A`: the group of an index list, which runs one object at a time.
@@ -163,6 +195,14 @@ impl BoxGroup<1> for Vec3A {
     fn all_set() -> BVec3A {
         BVec3A::TRUE
     }
+    #[inline(always)]
+    fn le_xyz(a: Self, b: Self) -> u32 {
+        u32::from(a.cmple(b).all())
+    }
+    #[inline(always)]
+    fn pick(parts: u32, a: Self, b: Self) -> Self {
+        Vec3A::select(BVec3A::splat(parts & 1 != 0), a, b)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -172,10 +212,11 @@ pub(crate) use avx::AvxPair;
 #[allow(unsafe_code)] // the AVX intrinsics, under the invariant of `AvxPair`
 mod avx {
     use core::arch::x86_64::{
-        __m256, _CMP_GE_OQ, _CMP_LE_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps,
-        _mm256_blendv_ps, _mm256_castps128_ps256, _mm256_castps256_ps128, _mm256_cmp_ps,
-        _mm256_extractf128_ps, _mm256_insertf128_ps, _mm256_max_ps, _mm256_min_ps,
-        _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_ps, _mm256_setzero_ps,
+        __m256, _CMP_GE_OQ, _CMP_LE_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256,
+        _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps128_ps256, _mm256_castps256_ps128,
+        _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_extractf128_ps,
+        _mm256_insertf128_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
+        _mm256_permute_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_ps,
         _mm256_sub_ps, _mm256_xor_ps,
     };
     use core::ops::{Add, Mul, Neg, Sub};
@@ -317,6 +358,21 @@ mod avx {
         #[inline(always)]
         fn all_set() -> __m256 {
             avx!(_mm256_set1_ps(f32::from_bits(u32::MAX)))
+        }
+        #[inline(always)]
+        fn le_xyz(a: Self, b: Self) -> u32 {
+            let le = avx!(_mm256_cmp_ps::<_CMP_LE_OQ>(a.0, b.0));
+            super::whole_parts(avx!(_mm256_movemask_ps(le)) as u32)
+        }
+        #[inline(always)]
+        fn pick(parts: u32, a: Self, b: Self) -> Self {
+            // Lane `j` takes `a` where bit `j / 4` of `parts` is set: the spread bits
+            // broadcast, each lane's own bit tested, as a sign mask for `vblendvps`.
+            let bits = avx!(_mm256_set1_epi32(super::spread_parts(parts) as i32));
+            let lane = avx!(_mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128));
+            let own = avx!(_mm256_and_si256(bits, lane));
+            let mask = avx!(_mm256_castsi256_ps(_mm256_cmpeq_epi32(own, lane)));
+            AvxPair(avx!(_mm256_blendv_ps(b.0, a.0, mask)))
         }
     }
 }
@@ -486,6 +542,57 @@ mod avx512 {
         #[inline(always)]
         fn all_set() -> __mmask16 {
             0xFFFF
+        }
+        #[inline(always)]
+        fn le_xyz(a: Self, b: Self) -> u32 {
+            super::whole_parts(u32::from(avx512!(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(
+                a.0, b.0
+            ))))
+        }
+        #[inline(always)]
+        fn pick(parts: u32, a: Self, b: Self) -> Self {
+            let mask = super::spread_parts(parts) as __mmask16;
+            Avx512Quad(avx512!(_mm512_mask_blend_ps(mask, b.0, a.0)))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_part_counts_only_with_x_y_and_z_and_spreads_back() {
+        for parts in 0..16 {
+            assert_eq!(whole_parts(spread_parts(parts)), parts);
+        }
+        // The fourth component (`w`) is ignored; a part with any of x, y, z clear is out.
+        assert_eq!(whole_parts(0b0111), 0b0001);
+        assert_eq!(whole_parts(0b1011), 0);
+        assert_eq!(whole_parts(0x8888), 0);
+        assert_eq!(whole_parts(0x7370), 0b1010);
+    }
+
+    #[test]
+    fn the_pair_tests_and_picks_part_by_part() {
+        let lo = Vec3A::new(0.0, 0.0, 0.0);
+        let hi = Vec3A::new(1.0, 1.0, 1.0);
+        let nan = Vec3A::new(0.0, f32::NAN, 0.0);
+        let le = |a: [Vec3A; 2], b: [Vec3A; 2]| Two::le_xyz(Two::join(a), Two::join(b));
+        assert_eq!(le([lo, lo], [hi, hi]), 0b11);
+        assert_eq!(le([lo, hi], [hi, lo]), 0b01);
+        assert_eq!(le([hi, lo], [lo, hi]), 0b10);
+        // Ordered: a NaN component fails the test, on either side.
+        assert_eq!(le([nan, lo], [hi, nan]), 0);
+        // Only x, y and z count.
+        let w = Vec3A::from_vec4(glam::Vec4::new(0.0, 0.0, 0.0, 9.0));
+        assert_eq!(le([w, w], [lo, lo]), 0b11);
+        for parts in 0..4 {
+            let got = Two::pick(parts, Two::join([lo, lo]), Two::join([hi, hi])).parts();
+            for (k, got) in got.into_iter().enumerate() {
+                let want = if parts >> k & 1 != 0 { lo } else { hi };
+                assert_eq!(got, want, "parts {parts:#b}, part {k}");
+            }
         }
     }
 }
