@@ -63,6 +63,12 @@ pub trait Lane:
 pub trait Axes: Lane {
     /// The vector with every component equal to component `j` of `self`.
     fn axis(self, j: usize) -> Self;
+    /// Components `(y, x, x)` of `self`, as glam's `Vec3A::yxx`.
+    fn yxx(self) -> Self;
+    /// Components `(z, z, y)` of `self`, as glam's `Vec3A::zzy`.
+    fn zzy(self) -> Self;
+    /// Component `x` of `x`, `y` of `y` and `z` of `z`.
+    fn merge(x: Self, y: Self, z: Self) -> Self;
 }
 
 impl Lane for f32 {
@@ -134,6 +140,20 @@ impl Axes for Vec3A {
             1 => Vec3A::splat(self.y),
             _ => Vec3A::splat(self.z),
         }
+    }
+    #[inline(always)]
+    fn yxx(self) -> Self {
+        glam::Vec3Swizzles::yxx(self)
+    }
+    #[inline(always)]
+    fn zzy(self) -> Self {
+        glam::Vec3Swizzles::zzy(self)
+    }
+    #[inline(always)]
+    fn merge(x: Self, y: Self, z: Self) -> Self {
+        let keep_x = glam::BVec3A::new(true, false, false);
+        let keep_y = glam::BVec3A::new(false, true, false);
+        Vec3A::select(keep_x, x, Vec3A::select(keep_y, y, z))
     }
 }
 
@@ -229,9 +249,23 @@ impl<L: Lane, const N: usize> Lane for Vector<L, N> {
     }
 }
 
+/// The swizzles name components of a 3-vector; at other sizes they take the components of
+/// the same names cyclically.
 impl<L: Lane, const N: usize> Axes for Vector<L, N> {
     #[inline(always)]
     fn axis(self, j: usize) -> Self {
         Vector([self.0[j]; N])
+    }
+    #[inline(always)]
+    fn yxx(self) -> Self {
+        Vector(core::array::from_fn(|i| self.0[[1, 0, 0][i % 3] % N]))
+    }
+    #[inline(always)]
+    fn zzy(self) -> Self {
+        Vector(core::array::from_fn(|i| self.0[[2, 2, 1][i % 3] % N]))
+    }
+    #[inline(always)]
+    fn merge(x: Self, y: Self, z: Self) -> Self {
+        Vector(core::array::from_fn(|i| [x, y, z][i % 3].0[i]))
     }
 }

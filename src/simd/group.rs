@@ -124,6 +124,18 @@ impl Axes for Two {
     fn axis(self, j: usize) -> Self {
         Two(self.0.axis(j), self.1.axis(j))
     }
+    #[inline(always)]
+    fn yxx(self) -> Self {
+        Two(self.0.yxx(), self.1.yxx())
+    }
+    #[inline(always)]
+    fn zzy(self) -> Self {
+        Two(self.0.zzy(), self.1.zzy())
+    }
+    #[inline(always)]
+    fn merge(x: Self, y: Self, z: Self) -> Self {
+        Two(Vec3A::merge(x.0, y.0, z.0), Vec3A::merge(x.1, y.1, z.1))
+    }
 }
 
 impl BoxGroup<2> for Two {
@@ -213,11 +225,11 @@ pub(crate) use avx::AvxPair;
 mod avx {
     use core::arch::x86_64::{
         __m256, _CMP_GE_OQ, _CMP_LE_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256,
-        _mm256_andnot_ps, _mm256_blendv_ps, _mm256_castps128_ps256, _mm256_castps256_ps128,
-        _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32, _mm256_extractf128_ps,
-        _mm256_insertf128_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
-        _mm256_permute_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setr_epi32, _mm256_setzero_ps,
-        _mm256_sub_ps, _mm256_xor_ps,
+        _mm256_andnot_ps, _mm256_blend_ps, _mm256_blendv_ps, _mm256_castps128_ps256,
+        _mm256_castps256_ps128, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_cmpeq_epi32,
+        _mm256_extractf128_ps, _mm256_insertf128_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_epi32, _mm256_set1_ps,
+        _mm256_setr_epi32, _mm256_setzero_ps, _mm256_sub_ps, _mm256_xor_ps,
     };
     use core::ops::{Add, Mul, Neg, Sub};
 
@@ -317,6 +329,22 @@ mod avx {
                 1 => avx!(_mm256_permute_ps::<0x55>(self.0)),
                 _ => avx!(_mm256_permute_ps::<0xAA>(self.0)),
             })
+        }
+        #[inline(always)]
+        fn yxx(self) -> Self {
+            // Lanes (1, 0, 0, 3) of each half.
+            AvxPair(avx!(_mm256_permute_ps::<0b11_00_00_01>(self.0)))
+        }
+        #[inline(always)]
+        fn zzy(self) -> Self {
+            // Lanes (2, 2, 1, 3) of each half.
+            AvxPair(avx!(_mm256_permute_ps::<0b11_01_10_10>(self.0)))
+        }
+        #[inline(always)]
+        fn merge(x: Self, y: Self, z: Self) -> Self {
+            // Lane 1 of each half from `y`, then lane 2 from `z`.
+            let xy = avx!(_mm256_blend_ps::<0b0010_0010>(x.0, y.0));
+            AvxPair(avx!(_mm256_blend_ps::<0b0100_0100>(xy, z.0)))
         }
     }
 
@@ -499,6 +527,22 @@ mod avx512 {
                 1 => avx512!(_mm512_permute_ps::<0x55>(self.0)),
                 _ => avx512!(_mm512_permute_ps::<0xAA>(self.0)),
             })
+        }
+        #[inline(always)]
+        fn yxx(self) -> Self {
+            // Lanes (1, 0, 0, 3) of each part.
+            Avx512Quad(avx512!(_mm512_permute_ps::<0b11_00_00_01>(self.0)))
+        }
+        #[inline(always)]
+        fn zzy(self) -> Self {
+            // Lanes (2, 2, 1, 3) of each part.
+            Avx512Quad(avx512!(_mm512_permute_ps::<0b11_01_10_10>(self.0)))
+        }
+        #[inline(always)]
+        fn merge(x: Self, y: Self, z: Self) -> Self {
+            // Lane 1 of each part from `y`, then lane 2 from `z`.
+            let xy = avx512!(_mm512_mask_blend_ps(0x2222, x.0, y.0));
+            Avx512Quad(avx512!(_mm512_mask_blend_ps(0x4444, xy, z.0)))
         }
     }
 

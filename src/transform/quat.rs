@@ -5,7 +5,7 @@
 //! per face), then rotated by `R(q)`, computed in lanes straight from the quaternion, and
 //! translated. No `Affine3A` is built.
 
-use glam::{Affine3A, BVec3A, Mat3A, Quat, Vec3, Vec3A, Vec3Swizzles};
+use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
 use super::{Class, Named3, Transform3};
 use crate::extended::ExtendedMap;
@@ -211,22 +211,6 @@ impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatLanes<V, SCALED> {
     }
 }
 
-impl<const SCALED: bool> JoinLanes for QuatLanes<Vec3A, SCALED> {
-    type In<P: Axes> = QuatLanes<P, SCALED>;
-    #[inline(always)]
-    fn join<P: Axes, const W: usize>(
-        maps: &[Self; W],
-        join: impl Fn([Vec3A; W]) -> P,
-    ) -> QuatLanes<P, SCALED> {
-        QuatLanes {
-            cols: kernel::join_cols(maps, |m| &m.cols, &join),
-            rho: join(kernel::gather(|k| maps[k].rho)),
-            scale: join(kernel::gather(|k| maps[k].scale)),
-            t: join(kernel::gather(|k| maps[k].t)),
-        }
-    }
-}
-
 /// The method's order plus 3 for the rounding of `R(q)`, plus 1 for the scaled box.
 const fn quat_gamma(method: Method, scaled: bool) -> u32 {
     method.nearest_order(3) + 3 + scaled as u32
@@ -247,34 +231,77 @@ fn quat_lanes<L: Lane, const SCALED: bool>(
     }
 }
 
-/// The same on glam's `Vec3A`: `R(q)` in SIMD lanes, with the products and sums of
-/// [`kernel::rotation`] in the same order (so the same bits, without a round trip of nine
-/// scalars through memory).
-#[inline(always)]
-fn quat_simd<const SCALED: bool>(q: Quat, scale: Vec3A, t: Vec3A) -> QuatLanes<Vec3A, SCALED> {
-    let (v, w) = (Vec3A::new(q.x, q.y, q.z), q.w);
-    let v2 = v + v;
-    let sq = v * v2; // (xx, yy, zz)
-    let p = v.yxx() * v2.zzy(); // (yz, xz, xy)
-    let wv = Vec3A::splat(w) * v2; // (wx, wy, wz)
-    let diagonal = Vec3A::ONE - (sq.yxx() + sq.zzy()); // 1 − (yy + zz), …
-    let (a, b) = (p + wv, p - wv); // (yz + wx, xz + wy, xy + wz), (yz − wx, xz − wy, xy − wz)
-    let pick = |first: Vec3A, second: Vec3A, third: Vec3A| {
-        let keep_first = BVec3A::new(true, false, false);
-        let keep_second = BVec3A::new(false, true, false);
-        Vec3A::select(keep_first, first, Vec3A::select(keep_second, second, third))
-    };
-    let cols = [
-        pick(diagonal, a.zzz(), b.yyy()),
-        pick(b.zzz(), diagonal, a.xxx()),
-        pick(a.yyy(), b.xxx(), diagonal),
-    ];
-    let rho = 1.0 + ((sq.x + sq.y) + (sq.z + w * (w + w)));
-    QuatLanes {
-        cols,
-        rho: Vec3A::splat(rho),
-        scale,
-        t,
+/// A quaternion class's pose in lanes of `Vec3A` values (or several poses' side by side):
+/// the quaternion's vector part `(x, y, z)`, its `w` in every component, the per-axis scale
+/// and the translation. `R(q)` is computed in the lanes, where the kernel runs: once per
+/// group of poses in the AoS loop, on four poses at a time with AVX-512.
+#[derive(Clone, Copy, Debug)]
+pub struct QuatPose<V, const SCALED: bool> {
+    pub v: V,
+    pub w: V,
+    pub scale: V,
+    pub t: V,
+}
+
+impl<const SCALED: bool> QuatPose<Vec3A, SCALED> {
+    #[inline(always)]
+    fn new(q: Quat, scale: Vec3A, t: Vec3A) -> Self {
+        QuatPose {
+            v: Vec3A::new(q.x, q.y, q.z),
+            w: Vec3A::splat(q.w),
+            scale,
+            t,
+        }
+    }
+}
+
+impl<V: Axes, const SCALED: bool> QuatPose<V, SCALED> {
+    /// `R(q)` and `ρ`, with the products and sums of [`kernel::rotation`] in the same
+    /// order, so the same bits, in each part of the lanes.
+    #[inline(always)]
+    fn lanes(&self) -> QuatLanes<V, SCALED> {
+        let (v, w) = (self.v, self.w);
+        let v2 = v + v;
+        let sq = v * v2; // (xx, yy, zz)
+        let p = v.yxx() * v2.zzy(); // (yz, xz, xy)
+        let wv = w * v2; // (wx, wy, wz)
+        let diagonal = V::splat(1.0) - (sq.yxx() + sq.zzy()); // 1 − (yy + zz), …
+        let (a, b) = (p + wv, p - wv); // (yz + wx, xz + wy, xy + wz), (yz − wx, xz − wy, xy − wz)
+        let cols = [
+            V::merge(diagonal, a.axis(2), b.axis(1)),
+            V::merge(b.axis(2), diagonal, a.axis(0)),
+            V::merge(a.axis(1), b.axis(0), diagonal),
+        ];
+        let rho = V::splat(1.0) + ((sq.axis(0) + sq.axis(1)) + (sq.axis(2) + w * (w + w)));
+        QuatLanes {
+            cols,
+            rho,
+            scale: self.scale,
+            t: self.t,
+        }
+    }
+}
+
+impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatPose<V, SCALED> {
+    #[inline(always)]
+    fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V) {
+        self.lanes().transform(lo, hi, method, outward)
+    }
+}
+
+impl<const SCALED: bool> JoinLanes for QuatPose<Vec3A, SCALED> {
+    type In<P: Axes> = QuatPose<P, SCALED>;
+    #[inline(always)]
+    fn join<P: Axes, const W: usize>(
+        poses: &[Self; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> QuatPose<P, SCALED> {
+        QuatPose {
+            v: join(kernel::gather(|k| poses[k].v)),
+            w: join(kernel::gather(|k| poses[k].w)),
+            scale: join(kernel::gather(|k| poses[k].scale)),
+            t: join(kernel::gather(|k| poses[k].t)),
+        }
     }
 }
 
@@ -401,23 +428,23 @@ impl Class<3> for Trs3 {
 }
 
 impl Transform3 for Rigid3 {
-    type Simd = QuatLanes<Vec3A, false>;
+    type Simd = QuatPose<Vec3A, false>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
-        quat_simd(self.rotation, Vec3A::ONE, self.translation)
+        QuatPose::new(self.rotation, Vec3A::ONE, self.translation)
     }
 }
 impl Transform3 for Similarity3 {
-    type Simd = QuatLanes<Vec3A, true>;
+    type Simd = QuatPose<Vec3A, true>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
-        quat_simd(self.rotation, Vec3A::splat(self.scale), self.translation)
+        QuatPose::new(self.rotation, Vec3A::splat(self.scale), self.translation)
     }
 }
 impl Transform3 for Trs3 {
-    type Simd = QuatLanes<Vec3A, true>;
+    type Simd = QuatPose<Vec3A, true>;
     #[inline(always)]
     fn simd(&self) -> Self::Simd {
-        quat_simd(self.rotation, self.scale, self.translation)
+        QuatPose::new(self.rotation, self.scale, self.translation)
     }
 }
