@@ -310,6 +310,10 @@ impl LaneArray for wide::f32x8 {
         dst[..8].copy_from_slice(self.as_array());
     }
     #[inline(always)]
+    fn store_streaming(self, dst: &mut [f32]) {
+        F32s::<8, false>(self.to_array()).store_streaming(dst);
+    }
+    #[inline(always)]
     fn any_nonzero(self) -> bool {
         self.simd_ne(wide::f32x8::ZERO).any()
     }

@@ -16,7 +16,9 @@ use alloc::vec::Vec;
 pub(crate) use group::BoxGroup;
 #[cfg(target_arch = "x86_64")]
 use lanes::Avx8;
-pub(crate) use lanes::{F32s, LaneArray};
+#[cfg(any(test, not(all(target_arch = "x86_64", not(target_feature = "fma")))))]
+pub(crate) use lanes::F32s;
+pub(crate) use lanes::LaneArray;
 
 /// A code path for the batch kernels.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -24,8 +26,9 @@ pub(crate) use lanes::{F32s, LaneArray};
 pub enum Backend {
     /// One box at a time in plain `f32`: the reference every other backend is tested against.
     Scalar,
-    /// Portable lane arrays of 8, compiled for the build's baseline (SSE2 on x86-64, NEON
-    /// on aarch64).
+    /// Portable lanes of 8, compiled for the build's baseline (SSE2 on x86-64, NEON on
+    /// aarch64), never fused: on x86-64 built without FMA these are [`Backend::Wide`]'s
+    /// lanes, which do not fuse there; elsewhere plain arrays that LLVM vectorises.
     Baseline,
     /// 8 lanes in one 256-bit AVX register, compiled for AVX2 with FMA, chosen at run time
     /// (x86-64).
@@ -160,7 +163,18 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
     let fused = fused && cfg!(feature = "std");
     match (backend, fused) {
         (Backend::Scalar, _) => job.run::<f32>(),
+        // `wide` fuses exactly where FMA is enabled at compile time (on x86-64): without
+        // it, its lanes are the baseline's too, and one copy of the loop serves both. The
+        // plain arrays, whose code LLVM's vectoriser builds, then are not compiled as a
+        // loop at all: that copy was more than half of a call site's release rebuild (one
+        // `transform` and one `update` on AoSoA blocks, 32.3-32.9 s with it and 14.0-14.3 s
+        // without; a `Swept` update, 86-91 s and 29-32 s; AMD EPYC Zen 3, 2 cores). The
+        // speed is the same: both compile to SSE2 on the same vectors.
+        #[cfg(all(target_arch = "x86_64", not(target_feature = "fma")))]
+        (Backend::Baseline | Backend::Wide, _) => job.run::<wide::f32x8>(),
+        #[cfg(not(all(target_arch = "x86_64", not(target_feature = "fma"))))]
         (Backend::Baseline, _) | (Backend::Wide, false) => job.run::<F32s<8, false>>(),
+        #[cfg(not(all(target_arch = "x86_64", not(target_feature = "fma"))))]
         (Backend::Wide, true) => job.run::<wide::f32x8>(),
         // The AVX-512 backend runs the AVX2 lanes here: its own width is in the AoS loop
         // (`dispatch_groups`).
