@@ -237,10 +237,10 @@ fn quat_lanes<L: Lane, const SCALED: bool>(
 /// group of poses in the AoS loop, on four poses at a time with AVX-512.
 #[derive(Clone, Copy, Debug)]
 pub struct QuatPose<V, const SCALED: bool> {
-    pub v: V,
-    pub w: V,
-    pub scale: V,
-    pub t: V,
+    v: V,
+    w: V,
+    scale: V,
+    t: V,
 }
 
 impl<const SCALED: bool> QuatPose<Vec3A, SCALED> {
