@@ -238,11 +238,15 @@ fn active_set(n: usize, frame: usize, r: &mut StdRng) -> (Vec<usize>, Vec<u32>, 
     // On the mask's frames, every object of its second word: a whole span that does not
     // start at object 0.
     let whole = |i: usize| frame % 3 == 2 && (64..128).contains(&i);
+    // Two thirds of the objects, or on frame 4 one in 32: a list that sparse runs an entry
+    // at a time on the lane layouts, a dense one as a mask.
+    let mut listed = || match frame {
+        4 => r.random_range(0..32) == 0,
+        _ => r.random_range(0..3) != 0,
+    };
     let subset: Vec<usize> = match frame % 3 {
         0 => (0..n).collect(),
-        _ => (0..n)
-            .filter(|&i| whole(i) || r.random_range(0..3) != 0)
-            .collect(),
+        _ => (0..n).filter(|&i| whole(i) || listed()).collect(),
     };
     let indices = subset.iter().map(|&i| i as u32).collect();
     let mut mask = vec![0u64; n.div_ceil(64)];

@@ -11,6 +11,11 @@ pub enum Active<'a> {
     /// Every object.
     All,
     /// The objects at these indices, strictly ascending.
+    ///
+    /// AoS 3D boxes run a list an entry at a time. Every other layout runs a list of at
+    /// least one object in sixteen as the mask it builds from it (an allocation of
+    /// `len.div_ceil(64)` words), in lanes, and a sparser one an entry at a time. A dense
+    /// set kept as a [`Active::Mask`] skips that step.
     Indices(&'a [u32]),
     /// The objects whose bit is set: bit `i % 64` of word `i / 64`, with `len.div_ceil(64)`
     /// words and no bit at or past `len`.
@@ -122,6 +127,40 @@ pub(crate) trait Subset: Copy + core::fmt::Debug {
     fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span>;
     /// Its lookahead, nothing requested yet.
     fn lookahead(self) -> Lookahead<Self::Upcoming>;
+    /// True when the lane loop walks it an entry at a time (an index list: see
+    /// [`dense`]).
+    const BY_ENTRY: bool;
+}
+
+/// True when `count` objects of `len` are dense enough that the lane loop runs them as a
+/// mask, in lanes: at least one object in sixteen. A sparser list runs an entry at a time,
+/// in one lane: spans of eight objects would seldom hold two of its objects. (Updating
+/// 100,000 AoSoA rigid bodies in a random list, AMD EPYC Zen 5: one lane and a mask broke
+/// even at 6.5% listed; at 12.5% the mask took 13.5 ns an object and one lane 16.3 ns, at
+/// 1% one lane 16 ns and the mask 18.6 ns.)
+#[inline(always)]
+pub(crate) fn dense(count: usize, len: usize) -> bool {
+    count >= len / 16
+}
+
+/// The mask of a checked index list (strictly ascending, below `len`), for `len` objects.
+/// A word's bits gather in a register and are stored once: setting each bit in memory
+/// chained every entry of a dense list through the same word's load and store.
+pub(crate) fn mask_of(ix: &[u32], len: usize) -> alloc::vec::Vec<u64> {
+    let mut words = alloc::vec![0; len.div_ceil(64)];
+    let (mut word, mut bits) = (0, 0);
+    for &i in ix {
+        let at = i as usize / 64;
+        if at != word {
+            words[word] = bits;
+            (word, bits) = (at, 0);
+        }
+        bits |= 1 << (i % 64);
+    }
+    if let Some(last) = words.get_mut(word) {
+        *last = bits;
+    }
+    words
 }
 
 /// [`Active::Indices`]: the objects at these indices, strictly ascending.
@@ -134,6 +173,7 @@ pub(crate) struct Mask<'a>(pub &'a [u64]);
 
 impl<'a> Subset for List<'a> {
     type Upcoming = ListAhead<'a>;
+    const BY_ENTRY: bool = true;
     #[inline(always)]
     fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
         ListSpans::<W> {
@@ -151,6 +191,7 @@ impl<'a> Subset for List<'a> {
 
 impl<'a> Subset for Mask<'a> {
     type Upcoming = MaskAhead<'a>;
+    const BY_ENTRY: bool = false;
     #[inline(always)]
     fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
         MaskSpans::<W> {

@@ -52,7 +52,9 @@ mod aos;
 pub use active::Active;
 pub(crate) use aos::{AosCall, AosPoses, AosSink, PoseList, Tight};
 
-use active::{List, Lookahead, Mask, Span, Subset, Upcoming, Visit};
+use active::{
+    List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width, dense, mask_of,
+};
 use core::marker::PhantomData;
 
 use crate::aabb::Aabb3;
@@ -379,6 +381,22 @@ impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N,
         }
         match self.split() {
             (Active::All, run) => Self::dispatch(backend, fused, Every(run)),
+            // A dense list runs as a mask, in lanes; a sparse one an entry at a time, in one
+            // lane, where spans of the lane width would rarely hold two of its objects.
+            // So the lane loop compiles no walk that builds spans from a list: that walk
+            // was more than a third of a call site's release rebuild (one `transform` and
+            // one `update` on AoSoA blocks; more for a `Swept` update).
+            (Active::Indices(ix), run) if dense(ix.len(), run.len) => {
+                let words = mask_of(ix, run.len);
+                Self::dispatch(
+                    backend,
+                    fused,
+                    Scattered {
+                        run,
+                        set: Mask(&words),
+                    },
+                )
+            }
             (Active::Indices(ix), run) => {
                 Self::dispatch(backend, fused, Scattered { run, set: List(ix) })
             }
@@ -448,15 +466,16 @@ struct Run<const N: usize, B, P, S> {
     rounding: Rounding,
 }
 
-/// The lane loop's visit of a scattered active set, in spans of the lane width `L`.
-struct Spans<'r, L, R> {
+/// The lane loop's visit of a scattered active set, in lanes `L`, walked in spans of `W`:
+/// the lane width, or one object.
+struct Spans<'r, L, W, R> {
     run: &'r mut R,
     method: Method,
     outward: bool,
-    lanes: PhantomData<L>,
+    lanes: PhantomData<(L, W)>,
 }
 
-impl<L: LaneArray, const N: usize, B, P, S> Visit for Spans<'_, L, Run<N, B, P, S>>
+impl<L: LaneArray, W: SpanWidth, const N: usize, B, P, S> Visit for Spans<'_, L, W, Run<N, B, P, S>>
 where
     B: ReadBoxes<N> + Clone,
     P: Poses<N> + Clone,
@@ -477,7 +496,7 @@ where
             self.request(i);
         }
         let (method, outward) = (self.method, self.outward);
-        if span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
+        if W::OBJECTS == L::WIDTH && span.count == L::WIDTH && span.lanes & (span.lanes - 1) != 0 {
             self.run
                 .lanes::<L>(span.start, L::WIDTH, span.lanes, method, outward);
         } else {
@@ -532,13 +551,23 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
         let outward = run.rounding == Rounding::Outward;
         let len = run.len;
         specialise!(run.method, |method| {
-            let mut spans = Spans::<L, _> {
-                run: &mut run,
-                method,
-                outward,
-                lanes: PhantomData,
-            };
-            active::walk::<L>(set, len, &mut spans);
+            if A::BY_ENTRY {
+                let mut spans = Spans::<L, Width<1>, _> {
+                    run: &mut run,
+                    method,
+                    outward,
+                    lanes: PhantomData,
+                };
+                active::walk::<Width<1>>(set, len, &mut spans);
+            } else {
+                let mut spans = Spans::<L, L, _> {
+                    run: &mut run,
+                    method,
+                    outward,
+                    lanes: PhantomData,
+                };
+                active::walk::<L>(set, len, &mut spans);
+            }
         });
         run.sink.finish();
     }
