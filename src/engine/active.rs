@@ -124,7 +124,7 @@ pub(crate) trait Subset: Copy + core::fmt::Debug {
     type Upcoming: Upcoming;
     /// Its spans of `W::OBJECTS` objects, of `len` objects in all, ascending; spans with
     /// no active object are skipped.
-    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span>;
+    fn spans<W: SpanWidth>(self, len: usize) -> impl SpanIter;
     /// Its lookahead, nothing requested yet.
     fn lookahead(self) -> Lookahead<Self::Upcoming>;
     /// True when the lane loop walks it an entry at a time (an index list: see
@@ -175,7 +175,7 @@ impl<'a> Subset for List<'a> {
     type Upcoming = ListAhead<'a>;
     const BY_ENTRY: bool = true;
     #[inline(always)]
-    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
+    fn spans<W: SpanWidth>(self, len: usize) -> impl SpanIter {
         ListSpans::<W> {
             ix: self.0,
             len,
@@ -193,7 +193,7 @@ impl<'a> Subset for Mask<'a> {
     type Upcoming = MaskAhead<'a>;
     const BY_ENTRY: bool = false;
     #[inline(always)]
-    fn spans<W: SpanWidth>(self, len: usize) -> impl Iterator<Item = Span> {
+    fn spans<W: SpanWidth>(self, len: usize) -> impl SpanIter {
         MaskSpans::<W> {
             words: self.0,
             len,
@@ -208,6 +208,34 @@ impl<'a> Subset for Mask<'a> {
             word: 0,
             bits: self.0.first().copied().unwrap_or(0),
         })
+    }
+}
+
+/// A subset's spans, ascending.
+pub(crate) trait SpanIter: Iterator<Item = Span> {
+    /// Right after a whole span that ends at `end`: the end of the whole words of active
+    /// objects that follow it, the spans resuming there. `end` itself unless it starts a
+    /// word of 64 active objects, and always for a list.
+    #[inline(always)]
+    fn whole_words(&mut self, end: usize) -> usize {
+        end
+    }
+}
+
+impl<W: SpanWidth> SpanIter for ListSpans<'_, W> {}
+
+impl<W: SpanWidth> SpanIter for MaskSpans<'_, W> {
+    #[inline(always)]
+    fn whole_words(&mut self, end: usize) -> usize {
+        if !end.is_multiple_of(64) {
+            return end;
+        }
+        let mut word = end / 64;
+        while self.words.get(word) == Some(&u64::MAX) {
+            word += 1;
+        }
+        self.at = 64 * word;
+        self.at
     }
 }
 
@@ -292,7 +320,11 @@ pub(crate) trait Visit {
 
 /// The one walk of a scattered active set, in spans of `W::OBJECTS` objects: whole spans
 /// that follow each other are run together ([`Visit::whole`]), every other span on its own
-/// ([`Visit::part`]). Spans of one object are all scattered: an index list walked one entry
+/// ([`Visit::part`]). A run of whole spans goes on over a mask's whole words a word at a
+/// time ([`SpanIter::whole_words`]): span by span, a mask of islands (runs of 200 to 2,000
+/// objects, half of them active) cost the update of 100,000 AoSoA rigid bodies 1.06x
+/// (naive) to 1.14x (abs-matrix, sign-select) on the lane loop (medians of 8 runs, AMD EPYC
+/// Zen 5); the AoS loop's walk, in spans of 64, stayed the same. Spans of one object are all scattered: an index list walked one entry
 /// at a time (building spans of several objects from a list cost the AoS loop 1.2-1.3x at
 /// 1% and 10% active, AMD EPYC Zen 5; 1.4x on an Intel Xeon).
 #[inline(always)]
@@ -307,14 +339,33 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
         }
         return;
     }
-    let mut spans = set.spans::<W>(len).peekable();
-    while let Some(span) = spans.next() {
+    let mut spans = set.spans::<W>(len);
+    let mut pending = None;
+    while let Some(span) = pending.take().or_else(|| spans.next()) {
         ahead.enter(span);
         if span.is_full() {
             let mut end = span.start + span.count;
-            while let Some(next) = spans.next_if(|s| s.start == end && s.is_full()) {
-                ahead.enter(next);
-                end += next.count;
+            loop {
+                let words_end = spans.whole_words(end);
+                if words_end > end {
+                    // Entered as one whole span: the lookahead's requests are due again.
+                    ahead.enter(Span {
+                        start: end,
+                        count: 64,
+                        lanes: u64::MAX,
+                    });
+                    end = words_end;
+                }
+                match spans.next() {
+                    Some(next) if next.start == end && next.is_full() => {
+                        ahead.enter(next);
+                        end += next.count;
+                    }
+                    next => {
+                        pending = next;
+                        break;
+                    }
+                }
             }
             visit.whole(span.start, end);
         } else {
@@ -611,6 +662,32 @@ mod tests {
         let mut record = Record::default();
         walk::<Width<8>>(Mask(&full), 128, &mut record);
         assert_eq!(record.whole, [(0, 128)], "whole spans run together");
+        // Whole words skipped together, from a run that starts inside a word and up to the
+        // last object, or up to a span that is not whole.
+        let mut words = alloc::vec![u64::MAX; 5];
+        words[0] = u64::MAX << 8;
+        // (the last word, the whole run in spans of 8, in spans of 64)
+        for (last, by_8, by_64) in [
+            (u64::MAX, (8, 320), (64, 320)),
+            (u64::MAX >> 1, (8, 312), (64, 256)),
+        ] {
+            words[4] = last;
+            let want: Vec<usize> = (8..320).filter(|&i| i != 319 || last == u64::MAX).collect();
+            let mut record = Record::default();
+            walk::<Width<8>>(Mask(&words), 320, &mut record);
+            assert_eq!(
+                (&record.whole[..], &record.run),
+                (&[by_8][..], &want),
+                "{last:x}"
+            );
+            let mut record = Record::default();
+            walk::<Width<64>>(Mask(&words), 320, &mut record);
+            assert_eq!(
+                (&record.whole[..], &record.run),
+                (&[by_64][..], &want),
+                "{last:x}"
+            );
+        }
     }
 
     /// The lookahead requests active objects only, each once, in order, and each object of
