@@ -406,10 +406,9 @@ pub(crate) fn rotation_pad<V: Axes>(rho: V, t: V, lo: V, hi: V, k: u32) -> V {
     rho.mul_add(sum, t.abs()) * V::splat(k as f32 * UNIT_ROUNDOFF)
 }
 
-/// The boxes `[lo, hi]` through `map` on the fast path, with a lane value that says where
-/// the result stands: 0 where the box is non-empty with no NaN and the result finite,
-/// NaN elsewhere. Those lanes must be recomputed by
-/// [`crate::extended`]. One float per lane lets a single compare test every lane.
+/// The boxes `[lo, hi]` through `map` on the fast path, with a lane value `redo` that says
+/// where the result does not stand: 0 where the box is non-empty with no NaN and the result
+/// finite, NaN elsewhere. Those lanes must be redone by [`crate::extended`]. One float per lane lets a single compare test every lane.
 ///
 /// Per axis: `(hi − lo).select_nonneg(0, NaN)` is 0 for a non-empty axis (an overflowing
 /// `hi − lo = +inf` included) and NaN for an empty or NaN one, and `(max − min)·0` is 0
@@ -426,11 +425,11 @@ pub(crate) fn transform_checked<L: Lane, const N: usize, M: MapKernel<Vector<L, 
 ) -> (Vector<L, N>, Vector<L, N>, L) {
     let (min, max) = map.transform(lo, hi, method, outward);
     let (zero, nan) = (L::splat(0.0), L::splat(f32::NAN));
-    let mut stands = zero;
+    let mut redo = zero;
     for i in 0..N {
         let empty = (hi.0[i] - lo.0[i]).select_nonneg(zero, nan);
         let unbounded = (max.0[i] - min.0[i]) * zero;
-        stands = stands + empty + unbounded;
+        redo = redo + empty + unbounded;
     }
-    (min, max, stands)
+    (min, max, redo)
 }

@@ -7,7 +7,7 @@ use super::large::LargeRigid3;
 use super::moved::Moved;
 use super::{Batch, PoseSource};
 use crate::aabb::Aabb3;
-use crate::engine::{Active, AosCall, AosSink, Engine, PoseList, Poses, Redo, Sink, Tight};
+use crate::engine::{Active, AosCall, AosSink, Engine, Extended, PoseList, Poses, Sink, Tight};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::kernel::gather;
@@ -292,23 +292,23 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
         count: usize,
         lanes: u64,
         tight: [Vector<L, N>; 2],
-        stands: L,
-        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        redo: L,
+        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) {
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
         let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
         // The common case, every box inside its fat box and standing: one reduction.
-        if !(outside + stands).any_nonzero() {
+        if !(outside + redo).any_nonzero() {
             return;
         }
         self.rewrite(
             i,
             count,
             lanes,
-            [outside.portable(), stands.portable()],
+            [outside.portable(), redo.portable()],
             tight.map(L::portable_vector),
             [fat_min, fat_max].map(L::portable_vector),
-            redo,
+            extended,
         );
     }
     #[inline(always)]
@@ -348,14 +348,14 @@ impl<F> Fat<'_, F> {
         i: usize,
         count: usize,
         lanes: u64,
-        [outside, stands]: [L; 2],
+        [outside, redo]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
-        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) where
         F: WriteBoxes<N>,
     {
-        let redo_lanes = u64::from(stands.nonzero_mask()) & lanes;
+        let redo_lanes = u64::from(redo.nonzero_mask()) & lanes;
         let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
         if left != 0 && lanes != u64::MAX >> (64 - count) {
             // A span shared with inactive objects: only the boxes rewritten are stored, so
@@ -396,7 +396,7 @@ impl<F> Fat<'_, F> {
         let mut bits = redo_lanes;
         while bits != 0 {
             let k = bits.trailing_zeros() as usize;
-            if self.redo(i + k, redo.tight(i + k)) {
+            if self.leaves(i + k, extended.tight(i + k)) {
                 moved |= 1 << k;
             }
             bits &= bits - 1;
@@ -404,10 +404,10 @@ impl<F> Fat<'_, F> {
         self.moved.record(i, moved);
     }
 
-    /// Object `i`'s tight box from the extended path; true when it left its fat box,
-    /// which is then rewritten.
+    /// True when object `i`'s tight box from the extended path leaves its fat box, which
+    /// is then rewritten.
     #[cold]
-    fn redo<const N: usize>(&mut self, i: usize, tight: [[f32; N]; 2]) -> bool
+    fn leaves<const N: usize>(&mut self, i: usize, tight: [[f32; N]; 2]) -> bool
     where
         F: WriteBoxes<N>,
     {

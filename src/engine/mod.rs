@@ -73,8 +73,8 @@ pub(crate) trait Poses<const N: usize> {
     /// Refuses a pose count other than `len` (a shared pose has none).
     fn check_len(&self, len: usize) -> Result<(), BatchError>;
     /// The tight boxes of objects `i..i + count` from their local boxes in lanes, and a
-    /// lane value that is 0 where the result stands and nonzero where the object must be
-    /// recomputed by [`Poses::tight_one`].
+    /// lane value `redo`: 0 where the result stands, nonzero where the object must be
+    /// redone by [`Poses::tight_one`].
     fn tight<L: LaneArray>(
         &self,
         i: usize,
@@ -165,14 +165,14 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
 /// and every column's bound be checked on every span (as happened when the cold path called
 /// a closure that borrowed them); and the cold path's addressing must stay out of the loop
 /// (inlined, it made LLVM keep a pointer per column, in stack slots updated on every span).
-pub(crate) struct Redo<'r, B, P> {
+pub(crate) struct Extended<'r, B, P> {
     local: &'r B,
     poses: &'r P,
     method: Method,
     rounding: Rounding,
 }
 
-impl<B: Clone, P: Clone> Redo<'_, B, P> {
+impl<B: Clone, P: Clone> Extended<'_, B, P> {
     /// Object `i`'s tight box `[min, max]`.
     #[inline(always)]
     pub(crate) fn tight<const N: usize>(&self, i: usize) -> [[f32; N]; 2]
@@ -206,16 +206,16 @@ fn tight_one<const N: usize, B: ReadBoxes<N>, P: Poses<N>>(
 /// Where the lane loop's tight boxes go.
 pub(crate) trait Sink<const N: usize> {
     /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
-    /// `lanes` bits are active. Where `stands` is nonzero the lane's box must be replaced
-    /// by `redo.tight(i + k)`, its box on the extended path.
+    /// `lanes` bits are active. Where `redo` is nonzero the lane's box does not stand and
+    /// must be replaced by `extended.tight(i + k)`, its box on the extended path.
     fn span<L: LaneArray>(
         &mut self,
         i: usize,
         count: usize,
         lanes: u64,
         tight: [Vector<L, N>; 2],
-        stands: L,
-        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        redo: L,
+        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     );
     /// Asks for object `i`'s output ahead of a scattered access.
     #[inline(always)]
@@ -256,8 +256,8 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         count: usize,
         lanes: u64,
         [min, max]: [Vector<L, N>; 2],
-        stands: L,
-        redo: &Redo<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        redo: L,
+        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
     ) {
         // Every object is active: a store writes whole spans.
         debug_assert_eq!(lanes.count_ones() as usize, count);
@@ -272,11 +272,11 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         // `&mut self` out of line, so the layout descriptors stay in registers (calling
         // out of line with them cost an in-cache AoSoA translation batch 1.1-1.35x; both
         // measured on an Intel Xeon).
-        if stands.any_nonzero() {
+        if redo.any_nonzero() {
             core::hint::cold_path();
             for k in 0..count {
-                if stands.get(k) != 0.0 {
-                    let [min, max] = redo.tight(i + k);
+                if redo.get(k) != 0.0 {
+                    let [min, max] = extended.tight(i + k);
                     self.out.set(i + k, min, max);
                 }
             }
@@ -639,13 +639,13 @@ where
         outward: bool,
     ) {
         let (lo, hi) = self.local.load::<L>(i, count);
-        let (min, max, stands) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
-        let redo = Redo {
+        let (min, max, redo) = self.poses.tight::<L>(i, count, lo, hi, method, outward);
+        let extended = Extended {
             local: &self.local,
             poses: &self.poses,
             method,
             rounding: self.rounding,
         };
-        self.sink.span(i, count, lanes, [min, max], stands, &redo);
+        self.sink.span(i, count, lanes, [min, max], redo, &extended);
     }
 }
