@@ -16,7 +16,8 @@ pub trait LaneArray: Lane {
     /// The number of lanes.
     const WIDTH: usize;
     /// One lane with the same arithmetic (fused exactly when `Self` fuses): the lane type
-    /// of the last, partial span, so that every box is rounded the same wherever it sits.
+    /// of an index list's entries, run one at a time, so that every box is rounded the same
+    /// whichever way it runs.
     type One: LaneArray;
     /// Lane `k`.
     fn get(&self, k: usize) -> f32;
