@@ -28,39 +28,39 @@ use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translati
 const SPAN: usize = 64;
 
 /// A sink the AoS loop can write: the lane loop's sink over AoS 3D boxes, which also takes
-/// their tight boxes from the single-box kernel ([`Tight`]), several at a time or one.
+/// the AoS loop's tight boxes, a chunk of [`CHUNK`] at a time or one. The loop computes a
+/// chunk into the slice the sink gives ([`AosSink::chunk`]), then hands it over
+/// ([`AosSink::take`]): the sink never calls back into the loop.
 pub(crate) trait AosSink: Sink<3> {
-    /// Objects `start..start + local.len()`, every one active, `start` a multiple of 64
-    /// (a whole span of the walk, or object 0): object `start + k`'s tight box is
-    /// `tight.of(&local[k], poses.at(start + k))`, computed by [`Tight::boxes`].
-    fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
-        &mut self,
-        start: usize,
-        local: &[Aabb3],
-        poses: impl PoseList<'p, T>,
-        tight: Tight<P, W>,
-    );
+    /// Where the tight boxes of objects `first..first + len` are computed (`len` at most
+    /// [`CHUNK`]): the output itself, or `scratch`.
+    fn chunk<'s>(
+        &'s mut self,
+        first: usize,
+        len: usize,
+        scratch: &'s mut [Aabb3; CHUNK],
+    ) -> &'s mut [Aabb3];
+    /// The tight boxes `tight` of objects `first..first + tight.len()`, computed where
+    /// [`AosSink::chunk`] said (`scratch` itself, where it said so), compared in groups
+    /// `P` of `W` boxes.
+    fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]);
     /// Object `i` alone, with its tight box.
     fn one(&mut self, i: usize, tight: Aabb3);
 }
 
-/// The plain sink on the AoS loop: every tight box written.
+/// The plain sink on the AoS loop: every tight box written where it is computed.
 impl AosSink for Store<&mut [Aabb3]> {
     #[inline(always)]
-    fn run<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
-        &mut self,
-        start: usize,
-        local: &[Aabb3],
-        poses: impl PoseList<'p, T>,
-        tight: Tight<P, W>,
-    ) {
-        tight.boxes(
-            local,
-            poses,
-            start,
-            &mut self.out[start..start + local.len()],
-        );
+    fn chunk<'s>(
+        &'s mut self,
+        first: usize,
+        len: usize,
+        _: &'s mut [Aabb3; CHUNK],
+    ) -> &'s mut [Aabb3] {
+        &mut self.out[first..first + len]
     }
+    #[inline(always)]
+    fn take<const W: usize, P: BoxGroup<W>>(&mut self, _: usize, _: &[Aabb3]) {}
     #[inline(always)]
     fn one(&mut self, i: usize, tight: Aabb3) {
         self.out[i] = tight;
@@ -68,7 +68,7 @@ impl AosSink for Store<&mut [Aabb3]> {
 }
 
 /// The validity test of the AoS loop is taken once per this many objects.
-const CHUNK: usize = 64;
+pub(crate) const CHUNK: usize = 64;
 
 /// The single-box kernel of one method and rounding, and its groups `P` of `W` boxes. A
 /// method call rather than a closure: a closure was compiled out of line, with the method as
@@ -428,11 +428,34 @@ fn whole<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
     let AosRun {
         local, mut sink, ..
     } = run;
-    sink.run(0, local, poses, tight);
+    chunks(&mut sink, 0, local, poses, tight);
+}
+
+/// Objects `start..start + local.len()`, every one active, `start` a multiple of [`CHUNK`]:
+/// their tight boxes into the sink a chunk at a time.
+#[inline(always)]
+fn chunks<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
+    sink: &mut S,
+    start: usize,
+    local: &[Aabb3],
+    poses: impl PoseList<'p, T>,
+    tight: Tight<P, W>,
+) {
+    let mut scratch = [Aabb3::EMPTY; CHUNK];
+    for (c, local) in local.chunks(CHUNK).enumerate() {
+        let first = start + c * CHUNK;
+        tight.boxes(
+            local,
+            poses,
+            first,
+            sink.chunk(first, local.len(), &mut scratch),
+        );
+        sink.take::<W, P>(first, &scratch[..local.len()]);
+    }
 }
 
 /// The active objects of `set` ([`active::walk`]): runs of whole spans several boxes per
-/// vector, with the validity test per chunk ([`AosSink::run`]), and the objects of other
+/// vector, with the validity test per chunk ([`Tight::boxes`]), and the objects of other
 /// spans one at a time.
 #[inline(always)]
 fn scattered<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>, Sp: SpanWidth>(
@@ -471,7 +494,7 @@ where
     #[inline(always)]
     fn whole(&mut self, start: usize, end: usize) {
         let local = &self.local[start..end];
-        self.sink.run(start, local, self.poses, self.tight);
+        chunks(&mut self.sink, start, local, self.poses, self.tight);
     }
 
     /// One object at a time, each requesting one object further as it runs (a burst of

@@ -37,7 +37,7 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{AosCall, AosPoses, AosSink, PoseList, Tight};
+pub(crate) use aos::{AosCall, AosPoses, AosSink, CHUNK};
 
 use active::{
     List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width, dense, mask_of,
