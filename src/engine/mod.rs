@@ -13,8 +13,18 @@
 //!   the AoS loop, or on the scalar backend the lane loop.
 
 /// `$body` once per method, with `$m` bound to it as a constant, so that each copy is
-/// specialised to its kernel: the one place the methods are spelled out.
+/// specialised to its kernel: the one place the methods are spelled out. With `if $cond`
+/// first, only where the constant `$cond` holds; otherwise `$body` once, with `$m` the
+/// method as a run-time value.
 macro_rules! specialise {
+    (if $cond:expr, $method:expr, |$m:ident| $body:expr) => {
+        if $cond {
+            specialise!($method, |$m| $body)
+        } else {
+            let $m = $method;
+            $body
+        }
+    };
     ($method:expr, |$m:ident| $body:expr) => {
         match $method {
             Method::Naive => {
@@ -512,7 +522,12 @@ struct Scattered<const N: usize, B, P, S, A> {
 
 impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, B, P, S> {
     /// One loop per method, so that each is specialised to its kernel; the rounding is a
-    /// loop-invariant branch. Specialising it too grew the `speed` bench binary by 15%;
+    /// loop-invariant branch. The scalar reference (lanes of one) has one loop, the method
+    /// a run-time value: it is there to be checked against, not to be fast. Its three
+    /// copies were 42K of the library's 539K lines of optimised IR (the AoS classes run
+    /// it on the scalar backend), and 2K of an AoSoA call site's 37K; the scalar backend's
+    /// in-cache AoSoA transform went from 29.5 to 41-43 ns a box naive, 15.6 to 15.8-23
+    /// ns abs-matrix (AMD EPYC Zen 5). Specialising it too grew the `speed` bench binary by 15%;
     /// it sped most in-cache SoA rows by up to 24% but made one rigid row 3.3x slower,
     /// where LLVM built the quaternion lanes' arithmetic from 128-bit pieces through the
     /// stack (measured on an Intel Xeon; the issue 23 notes have the tables).
@@ -521,7 +536,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, 
         let mut run = self.0.trim();
         let outward = run.rounding == Rounding::Outward;
         let len = run.len;
-        specialise!(run.method, |method| run.range::<L>(0, len, method, outward));
+        specialise!(if L::WIDTH > 1, run.method, |method| run.range::<L>(0, len, method, outward));
         run.sink.finish();
     }
 }
@@ -535,7 +550,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
         let (mut run, set) = (self.run.trim(), self.set);
         let outward = run.rounding == Rounding::Outward;
         let len = run.len;
-        specialise!(run.method, |method| {
+        specialise!(if L::WIDTH > 1, run.method, |method| {
             if A::BY_ENTRY {
                 let mut spans = Spans::<L, Width<1>, _> {
                     run: &mut run,
