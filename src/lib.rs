@@ -170,8 +170,8 @@ mod transform;
 pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
-pub use batch::{Batch, LargePose, LargeRigid3, LargeWorld, Moved, PoseSource, Swept};
-pub use engine::Active;
+pub use batch::{Batch, LargePose, LargeRigid3, LargeWorld, Moved, Swept};
+pub use engine::{Active, PoseSource};
 pub use error::{BatchError, TransformError};
 pub use fat::Margin;
 pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};

@@ -16,19 +16,11 @@ pub use update::{LargeWorld, Swept};
 
 #[cfg(doc)]
 use crate::aabb::Aabb3;
-use crate::engine::Poses;
+use crate::engine::PoseSource;
 use crate::error::BatchError;
-#[cfg(doc)]
 use crate::layout::{BoxSink, BoxSource};
-use crate::layout::{ReadBoxes, WriteBoxes};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-
-/// The poses a batch reads, for [`Batch::transform`] and [`Batch::update`] alike: transforms
-/// of any class in any layout (AoS slices `&[T]`, AoSoA blocks, SoA columns, or one shared
-/// `&T`), a [`Swept`] pair of them, or [`LargeWorld`] poses. Sealed.
-pub trait PoseSource<const N: usize>: Poses<N> {}
-impl<const N: usize, P: Poses<N>> PoseSource<N> for P {}
 
 /// How a batch runs: the method, the rounding and the backend.
 ///
@@ -134,9 +126,9 @@ impl Batch {
 }
 
 fn checked_len<const N: usize>(
-    local: &impl ReadBoxes<N>,
-    poses: &impl Poses<N>,
-    out: &mut impl WriteBoxes<N>,
+    local: &impl BoxSource<N>,
+    poses: &impl PoseSource<N>,
+    out: &mut impl BoxSink<N>,
 ) -> Result<usize, BatchError> {
     let len = local.len()?;
     poses.check_len(len)?;
@@ -154,13 +146,13 @@ mod tests {
     use super::*;
     use crate::aabb::Aabb3;
     use crate::engine::{Active, Engine, Store};
-    use crate::layout::{Aabb3x8, Block8, ReadMaps};
+    use crate::layout::{Aabb3x8, Block8, TransformSource};
     use crate::simd::{F32s, LaneArray};
     use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
 
-    fn run_lanes<L: LaneArray, B: ReadBoxes<3>, X: ReadMaps<3>, O: WriteBoxes<3>>(
+    fn run_lanes<L: LaneArray, B: BoxSource<3>, X: TransformSource<3>, O: BoxSink<3>>(
         method: Method,
         rounding: Rounding,
         local: B,
@@ -215,7 +207,7 @@ mod tests {
     }
 
     /// Layouts whose types say they are AoS 3D boxes with AoS or shared poses.
-    fn aos<B: ReadBoxes<3>, X: Poses<3>, O: WriteBoxes<3>>(local: B, xf: X, mut out: O) {
+    fn aos<B: BoxSource<3>, X: PoseSource<3>, O: BoxSink<3>>(local: B, xf: X, mut out: O) {
         assert!(Engine::<3, B, X, Store<O>>::AOS);
         assert!(local.aabb3s().is_some() && xf.aos().is_some() && out.aabb3s_mut().is_some());
     }

@@ -10,19 +10,18 @@
 use alloc::vec::Vec;
 use rayon::prelude::*;
 
-use super::PoseSource;
 use super::update::check_update;
 use super::{Batch, checked_len};
 use crate::aabb::Aabb3;
 use crate::batch::Moved;
-use crate::engine::Active;
-use crate::engine::{AosPoses, Poses};
+use crate::engine::{Active, PoseSource, window};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, ReadBoxes};
+use crate::layout::{BoxSink, BoxSource};
 use crate::method::{Method, Rounding};
 use crate::simd::LaneArray;
+use crate::transform::Named3;
 
 /// The fewest boxes a part gets: below this the pool's overhead outweighs the work.
 const MIN_PART: usize = 4096;
@@ -40,7 +39,7 @@ impl<S> Clone for Window<'_, S> {
     }
 }
 
-impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
+impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(self.len)
     }
@@ -63,7 +62,7 @@ impl<const N: usize, S: ReadBoxes<N>> ReadBoxes<N> for Window<'_, S> {
     }
 }
 
-impl<const N: usize, S: Poses<N>> Poses<N> for Window<'_, S> {
+impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
     // The whole source's length was checked.
     fn check_len(&self, _: usize) -> Result<(), BatchError> {
         Ok(())
@@ -96,8 +95,8 @@ impl<const N: usize, S: Poses<N>> Poses<N> for Window<'_, S> {
         self.src.prefetch(self.start + i);
     }
     const AOS: bool = S::AOS;
-    fn aos(&self) -> Option<AosPoses<'_>> {
-        self.src.aos()?.window(self.start, self.len)
+    fn aos(&self) -> Option<Named3<'_>> {
+        window(self.src.aos()?, self.start, self.len)
     }
     type Trimmed = Self;
     #[inline(always)]

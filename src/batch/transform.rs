@@ -1,8 +1,7 @@
 //! [`Batch::transform`]: the engine with every object active and the plain sink.
 
-use super::PoseSource;
 use super::{Batch, checked_len};
-use crate::engine::{Active, Engine, Store};
+use crate::engine::{Active, Engine, PoseSource, Store};
 use crate::error::BatchError;
 use crate::layout::{BoxSink, BoxSource};
 

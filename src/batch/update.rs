@@ -1,18 +1,18 @@
 //! The per-frame broadphase update (documented on [`Batch::update`]): a thin public layer
 //! over the engine, whose sink is the fat boxes and the moved set.
 
+use super::Batch;
 use super::large::LargePose;
 #[cfg(doc)]
 use super::large::LargeRigid3;
 use super::moved::Moved;
-use super::{Batch, PoseSource};
 use crate::aabb::Aabb3;
-use crate::engine::{Active, AosCall, AosSink, CHUNK, Engine, Extended, Poses, Sink};
+use crate::engine::{Active, AosCall, AosSink, CHUNK, Engine, Extended, PoseSource, Sink};
 use crate::error::BatchError;
 use crate::fat::Margin;
 use crate::kernel::gather;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, ReadBoxes, WriteBoxes};
+use crate::layout::{BoxSink, BoxSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, BoxGroup, LaneArray};
 
@@ -45,7 +45,7 @@ pub struct LargeWorld<'a, T> {
     pub origin: DVec3,
 }
 
-impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
+impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept<A, B> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         self.current.check_len(len)?;
         self.predicted.check_len(len)
@@ -104,7 +104,7 @@ impl<const N: usize, A: Poses<N>, B: Poses<N>> Poses<N> for Swept<A, B> {
     }
 }
 
-impl<T: LargePose> Poses<3> for LargeWorld<'_, T> {
+impl<T: LargePose> PoseSource<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         BatchError::check_len("poses", len, self.poses.len())
     }
@@ -283,7 +283,7 @@ struct Fat<'a, F> {
     moved: &'a mut Moved,
 }
 
-impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
+impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     #[inline(always)]
     fn span<L: LaneArray>(
         &mut self,
@@ -292,7 +292,7 @@ impl<'a, const N: usize, F: WriteBoxes<N>> Sink<N> for Fat<'a, F> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         redo: L,
-        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
     ) {
         let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
         let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
@@ -350,9 +350,9 @@ impl<F> Fat<'_, F> {
         [outside, redo]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
-        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
     ) where
-        F: WriteBoxes<N>,
+        F: BoxSink<N>,
     {
         let redo_lanes = u64::from(redo.nonzero_mask()) & lanes;
         let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
@@ -408,7 +408,7 @@ impl<F> Fat<'_, F> {
     #[cold]
     fn leaves<const N: usize>(&mut self, i: usize, tight: [[f32; N]; 2]) -> bool
     where
-        F: WriteBoxes<N>,
+        F: BoxSink<N>,
     {
         if crate::fat::inside(tight, self.fat.read().get(i).into()) {
             return false;
@@ -515,7 +515,7 @@ mod tests {
         written: &'w Cell<u64>,
     }
 
-    impl<const N: usize, F: WriteBoxes<N>> WriteBoxes<N> for Spy<'_, F> {
+    impl<const N: usize, F: BoxSink<N>> BoxSink<N> for Spy<'_, F> {
         fn len(&mut self) -> Result<usize, BatchError> {
             self.fat.len()
         }

@@ -13,13 +13,12 @@ use core::marker::PhantomData;
 use glam::Vec3A;
 
 use super::active::{self, List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width};
-use super::{Active, Engine, Poses, Sink, Store};
+use super::{Active, Engine, PoseSource, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
-use crate::layout::Maps;
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
-use crate::transform::{Class, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
+use crate::transform::{Maps, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of a span of a mask's walk ([`active::walk`]): a mask word's worth, whole
 /// words that follow each other run several boxes per vector. (Spans of eight cost a
@@ -161,27 +160,18 @@ impl<'p, T> PoseList<'p, T> for &'p [T] {
 }
 
 /// One pose shared by every object.
-struct Shared<'p, T>(&'p T);
-
-impl<T> Clone for Shared<'_, T> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-impl<T> Copy for Shared<'_, T> {}
-
-impl<'p, T> PoseList<'p, T> for Shared<'p, T> {
+impl<'p, T> PoseList<'p, T> for &'p T {
     #[inline(always)]
     fn at(self, _: usize) -> &'p T {
-        self.0
+        self
     }
     #[inline(always)]
     fn from(self, _: usize) -> impl Iterator<Item = &'p T> {
-        core::iter::repeat(self.0)
+        core::iter::repeat(self)
     }
     #[inline(always)]
     fn groups<const W: usize>(self, _: usize) -> impl Iterator<Item = [&'p T; W]> {
-        core::iter::repeat([self.0; W])
+        core::iter::repeat([self; W])
     }
 }
 
@@ -243,45 +233,23 @@ pub(crate) fn takes_aos(backend: Backend) -> bool {
     backend != Backend::Scalar
 }
 
-/// AoS or shared poses of a 3D class, by name: what a generic call site hands to the AoS
-/// runs that bvkit compiles once per class ([`AosCall`]).
-#[derive(Clone, Copy)]
-pub(crate) struct AosPoses<'a> {
-    poses: Named3<'a>,
-    shared: bool,
-}
-
-impl<'a> AosPoses<'a> {
-    /// The poses by name, where their class is a 3D one.
-    #[inline(always)]
-    pub fn of<const N: usize, T: Class<N>>(maps: Maps<'a, T>) -> Option<Self> {
-        let (poses, shared) = match maps {
-            Maps::Each(poses) => (poses, false),
-            Maps::Shared(pose) => (core::slice::from_ref(pose), true),
-        };
-        Some(AosPoses {
-            poses: T::named(poses)?,
-            shared,
-        })
-    }
-
-    /// The poses of objects `start..start + len` (a shared pose stays whole), or `None`
-    /// past the end: what one part of a parallel batch reads.
-    #[cfg(feature = "rayon")]
-    pub fn window(self, start: usize, len: usize) -> Option<Self> {
-        if self.shared {
-            return Some(self);
+/// The poses of objects `start..start + len` (a shared pose stays whole), or `None` past
+/// the end: what one part of a parallel batch reads.
+#[cfg(feature = "rayon")]
+pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Named3<'_>> {
+    fn part<T>(maps: Maps<'_, T>, start: usize, len: usize) -> Option<Maps<'_, T>> {
+        match maps {
+            Maps::Each(poses) => Some(Maps::Each(poses.get(start..start.checked_add(len)?)?)),
+            shared @ Maps::Shared(_) => Some(shared),
         }
-        let r = start..start.checked_add(len)?;
-        let poses = match self.poses {
-            Named3::Translation3(p) => Named3::Translation3(p.get(r)?),
-            Named3::Rigid3(p) => Named3::Rigid3(p.get(r)?),
-            Named3::Similarity3(p) => Named3::Similarity3(p.get(r)?),
-            Named3::Trs3(p) => Named3::Trs3(p.get(r)?),
-            Named3::Affine3A(p) => Named3::Affine3A(p.get(r)?),
-        };
-        Some(AosPoses { poses, ..self })
     }
+    Some(match poses {
+        Named3::Translation3(p) => Named3::Translation3(part(p, start, len)?),
+        Named3::Rigid3(p) => Named3::Rigid3(part(p, start, len)?),
+        Named3::Similarity3(p) => Named3::Similarity3(part(p, start, len)?),
+        Named3::Trs3(p) => Named3::Trs3(part(p, start, len)?),
+        Named3::Affine3A(p) => Named3::Affine3A(part(p, start, len)?),
+    })
 }
 
 /// A run of the engine over AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), with
@@ -292,7 +260,7 @@ pub(crate) struct AosCall<'a> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// The poses.
-    pub poses: AosPoses<'a>,
+    pub poses: Named3<'a>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -309,19 +277,12 @@ impl AosCall<'_> {
     /// its own, so that this code is compiled once, in bvkit, for the five classes.
     #[inline(always)]
     pub fn run<S: AosSink>(self, sink: S) {
-        fn maps<T>(poses: &[T], shared: bool) -> Maps<'_, T> {
-            match (shared, poses) {
-                (true, [pose]) => Maps::Shared(pose),
-                _ => Maps::Each(poses),
-            }
-        }
-        let shared = self.poses.shared;
-        match self.poses.poses {
-            Named3::Translation3(p) => self.class::<Translation3, S>(maps(p, shared), sink),
-            Named3::Rigid3(p) => self.class::<Rigid3, S>(maps(p, shared), sink),
-            Named3::Similarity3(p) => self.class::<Similarity3, S>(maps(p, shared), sink),
-            Named3::Trs3(p) => self.class::<Trs3, S>(maps(p, shared), sink),
-            Named3::Affine3A(p) => self.class::<glam::Affine3A, S>(maps(p, shared), sink),
+        match self.poses {
+            Named3::Translation3(maps) => self.class::<Translation3, S>(maps, sink),
+            Named3::Rigid3(maps) => self.class::<Rigid3, S>(maps, sink),
+            Named3::Similarity3(maps) => self.class::<Similarity3, S>(maps, sink),
+            Named3::Trs3(maps) => self.class::<Trs3, S>(maps, sink),
+            Named3::Affine3A(maps) => self.class::<glam::Affine3A, S>(maps, sink),
         }
     }
 
@@ -345,7 +306,7 @@ impl AosCall<'_> {
     }
 
     /// The lane loop with `poses`, on the scalar backend.
-    fn lanes<P: Poses<3>>(self, poses: P, sink: impl Sink<3>) {
+    fn lanes<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
         let engine = Engine {
             local: self.local,
             poses,
@@ -382,7 +343,7 @@ macro_rules! each_kernel {
         };
         match $maps {
             Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
-            Maps::Shared(pose) => $walk($run, Shared(pose), tight $(, $set)?),
+            Maps::Shared(pose) => $walk($run, pose, tight $(, $set)?),
         }
     }};
 }

@@ -8,7 +8,7 @@
 //!   one at a time on the extended path, and the sink takes those too;
 //! - the AoS loop, for AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), on the
 //!   single-box kernel (glam's `Vec3A`), on every backend but the scalar one. [`Engine::run`]
-//!   hands those layouts, the poses by name ([`AosPoses`]), to its sink
+//!   hands those layouts, the poses by name ([`Named3`]), to its sink
 //!   ([`Sink::run_aos`]), which runs them in code compiled here once ([`AosCall::run`]):
 //!   the AoS loop, or on the scalar backend the lane loop.
 
@@ -47,7 +47,9 @@ mod active;
 mod aos;
 
 pub use active::Active;
-pub(crate) use aos::{AosCall, AosPoses, AosSink, CHUNK};
+#[cfg(feature = "rayon")]
+pub(crate) use aos::window;
+pub(crate) use aos::{AosCall, AosSink, CHUNK};
 
 use active::{
     List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width, dense, mask_of,
@@ -59,19 +61,25 @@ use crate::error::BatchError;
 use crate::extended;
 use crate::kernel;
 use crate::lane::Vector;
-use crate::layout::{ReadBoxes, ReadMaps, WriteBoxes};
+use crate::layout::{BoxSink, BoxSource, TransformSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::Class;
+use crate::transform::{Class, Named3};
 
-/// Tight world boxes from local boxes: any transform source, and the broadphase's pose
-/// pairs and large-world poses.
-pub(crate) trait Poses<const N: usize> {
+/// The poses a batch reads, for [`Batch::transform`](crate::Batch::transform) and
+/// [`Batch::update`](crate::Batch::update) alike: transforms
+/// of any class in any layout (AoS slices `&[T]`, AoSoA blocks, SoA columns, or one shared
+/// `&T`), a [`Swept`](crate::Swept) pair of them, or [`LargeWorld`](crate::LargeWorld)
+/// poses. Sealed, as
+/// [`BoxSource`](crate::BoxSource).
+pub trait PoseSource<const N: usize> {
+    #[doc(hidden)]
     /// Refuses a pose count other than `len` (a shared pose has none).
     fn check_len(&self, len: usize) -> Result<(), BatchError>;
+    #[doc(hidden)]
     /// The tight boxes of objects `i..i + count` from their local boxes in lanes, and a
     /// lane value `redo`: 0 where the result stands, nonzero where the object must be
-    /// redone by [`Poses::tight_one`].
+    /// redone by [`PoseSource::tight_one`].
     fn tight<L: LaneArray>(
         &self,
         i: usize,
@@ -81,6 +89,7 @@ pub(crate) trait Poses<const N: usize> {
         method: Method,
         outward: bool,
     ) -> (Vector<L, N>, Vector<L, N>, L);
+    #[doc(hidden)]
     /// The tight box of object `i` on the extended path, which takes every input.
     fn tight_one(
         &self,
@@ -90,27 +99,32 @@ pub(crate) trait Poses<const N: usize> {
         method: Method,
         rounding: Rounding,
     ) -> [[f32; N]; 2];
+    #[doc(hidden)]
     /// Asks for object `i`'s poses ahead of a scattered access.
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
-    /// True when [`Poses::aos`] always returns the poses, given 3D boxes (AoS or shared
+    #[doc(hidden)]
+    /// True when [`PoseSource::aos`] always returns the poses, given 3D boxes (AoS or shared
     /// transforms).
     const AOS: bool = false;
+    #[doc(hidden)]
     /// The poses by name, for the AoS runs, where they are AoS or shared transforms of a 3D
     /// class.
-    fn aos(&self) -> Option<AosPoses<'_>> {
+    fn aos(&self) -> Option<Named3<'_>> {
         None
     }
+    #[doc(hidden)]
     /// The same poses, as the loop reads them.
-    type Trimmed: Poses<N> + Clone;
+    type Trimmed: PoseSource<N> + Clone;
+    #[doc(hidden)]
     /// The first `len` poses, every slice cut to that length (see
-    /// [`ReadBoxes::trim`](crate::layout::ReadBoxes::trim)).
+    /// [`BoxSource::trim`](crate::layout::BoxSource::trim)).
     fn trim(self, len: usize) -> Self::Trimmed;
 }
 
-impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
+impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         match self.len()? {
             Some(found) => BatchError::check_len("poses", len, found),
@@ -142,17 +156,17 @@ impl<const N: usize, X: ReadMaps<N>> Poses<N> for X {
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
-        ReadMaps::prefetch(self, i);
+        TransformSource::prefetch(self, i);
     }
     type Trimmed = X::Trimmed;
     #[inline(always)]
     fn trim(self, len: usize) -> X::Trimmed {
-        ReadMaps::trim(self, len)
+        TransformSource::trim(self, len)
     }
     const AOS: bool = X::MAPS;
     #[inline(always)]
-    fn aos(&self) -> Option<AosPoses<'_>> {
-        AosPoses::of(self.maps()?)
+    fn aos(&self) -> Option<Named3<'_>> {
+        X::Class::named(self.maps()?)
     }
 }
 
@@ -174,8 +188,8 @@ impl<B: Clone, P: Clone> Extended<'_, B, P> {
     #[inline(always)]
     pub(crate) fn tight<const N: usize>(&self, i: usize) -> [[f32; N]; 2]
     where
-        B: ReadBoxes<N>,
-        P: Poses<N>,
+        B: BoxSource<N>,
+        P: PoseSource<N>,
     {
         tight_one(
             self.local.clone(),
@@ -189,7 +203,7 @@ impl<B: Clone, P: Clone> Extended<'_, B, P> {
 
 /// Object `i`'s tight box on the extended path, from copies of the sources.
 #[inline(never)]
-fn tight_one<const N: usize, B: ReadBoxes<N>, P: Poses<N>>(
+fn tight_one<const N: usize, B: BoxSource<N>, P: PoseSource<N>>(
     local: B,
     poses: P,
     i: usize,
@@ -212,7 +226,7 @@ pub(crate) trait Sink<const N: usize> {
         lanes: u64,
         tight: [Vector<L, N>; 2],
         redo: L,
-        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
     );
     /// Asks for object `i`'s output ahead of a scattered access.
     #[inline(always)]
@@ -233,7 +247,7 @@ pub(crate) trait Sink<const N: usize> {
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
-    /// [`ReadBoxes::trim`](crate::layout::ReadBoxes::trim)).
+    /// [`BoxSource::trim`](crate::layout::BoxSource::trim)).
     fn trim(self, len: usize) -> Self::Trimmed;
 }
 
@@ -245,7 +259,7 @@ pub(crate) struct Store<O> {
     pub stream: bool,
 }
 
-impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
+impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
     #[inline(always)]
     fn span<L: LaneArray>(
         &mut self,
@@ -254,7 +268,7 @@ impl<const N: usize, O: WriteBoxes<N>> Sink<N> for Store<O> {
         lanes: u64,
         [min, max]: [Vector<L, N>; 2],
         redo: L,
-        extended: &Extended<'_, impl ReadBoxes<N> + Clone, impl Poses<N> + Clone>,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
     ) {
         // Every object is active: a store writes whole spans.
         debug_assert_eq!(lanes.count_ones() as usize, count);
@@ -332,7 +346,7 @@ pub(crate) struct Engine<'a, const N: usize, B, P, S> {
     pub rounding: Rounding,
 }
 
-impl<'a, const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
+impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
     /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): AoS 3D boxes with AoS
     /// or shared poses ([`Self::AOS`]) in code compiled once in bvkit, which runs the AoS
     /// loop or, on the scalar backend, the lane loop; every other layout in the lane loop,
@@ -474,8 +488,8 @@ struct Spans<'r, L, W, R> {
 
 impl<L: LaneArray, W: SpanWidth, const N: usize, B, P, S> Visit for Spans<'_, L, W, Run<N, B, P, S>>
 where
-    B: ReadBoxes<N> + Clone,
-    P: Poses<N> + Clone,
+    B: BoxSource<N> + Clone,
+    P: PoseSource<N> + Clone,
     S: Sink<N>,
 {
     #[inline(always)]
@@ -520,7 +534,7 @@ struct Scattered<const N: usize, B, P, S, A> {
     set: A,
 }
 
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, B, P, S> {
+impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Job for Every<N, B, P, S> {
     /// One loop per method, so that each is specialised to its kernel; the rounding is a
     /// loop-invariant branch. The scalar reference (lanes of one) has one loop, the method
     /// a run-time value: it is there to be checked against, not to be fast. Its three
@@ -541,7 +555,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Job for Every<N, 
     }
 }
 
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
+impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>, A: Subset> Job
     for Scattered<N, B, P, S, A>
 {
     /// As for [`Every`].
@@ -573,7 +587,7 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>, A: Subset> Job
     }
 }
 
-impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Run<N, B, P, S> {
+impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Run<N, B, P, S> {
     /// The run with every source and sink trimmed to `len`: called inside the job, so that
     /// the lengths the slices carry are the loop's own bound, and their checks fold into
     /// one per span.
@@ -593,8 +607,8 @@ impl<const N: usize, B: ReadBoxes<N>, P: Poses<N>, S: Sink<N>> Run<N, B, P, S> {
 
 impl<const N: usize, B, P, S> Run<N, B, P, S>
 where
-    B: ReadBoxes<N> + Clone,
-    P: Poses<N> + Clone,
+    B: BoxSource<N> + Clone,
+    P: PoseSource<N> + Clone,
     S: Sink<N>,
 {
     /// Objects `start..end`, every one active: a plain loop over spans of the lane width,

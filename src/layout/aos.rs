@@ -5,8 +5,8 @@
 //! that the lane arrays stay in registers and the main loop, where `count` is the lane
 //! width, has no mask at all.
 
+use super::{BoxSink, BoxSource, TransformSource};
 use super::{Maps, box_lanes, zero_fields};
-use super::{ReadBoxes, ReadMaps, WriteBoxes};
 use crate::aabb::Aabb3;
 use crate::aabb::Boxes;
 use crate::error::BatchError;
@@ -31,7 +31,7 @@ fn gather<L: LaneArray, T: Fields>(items: &[T], i: usize, count: usize) -> [L; M
     f
 }
 
-impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
+impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[B] {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(<[B]>::len(self))
     }
@@ -58,7 +58,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[B] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
+impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [B] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[B]>::len(self))
     }
@@ -115,7 +115,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [B] {
     }
 }
 
-impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
+impl<const N: usize, T: Class<N>> TransformSource<N> for &[T] {
     type Class = T;
     fn len(&self) -> Result<Option<usize>, BatchError> {
         Ok(Some(<[T]>::len(self)))
@@ -143,7 +143,7 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[T] {
 }
 
 /// One transform shared by every box (compound bodies, instanced props).
-impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
+impl<const N: usize, T: Class<N>> TransformSource<N> for &T {
     type Class = T;
     fn len(&self) -> Result<Option<usize>, BatchError> {
         Ok(None)
@@ -171,16 +171,16 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &T {
     }
 }
 
-impl<'a, const N: usize, E: Boxes<N>> ReadBoxes<N> for &'a Vec<E> {
+impl<'a, const N: usize, E: Boxes<N>> BoxSource<N> for &'a Vec<E> {
     fn len(&self) -> Result<usize, BatchError> {
-        ReadBoxes::len(&self.as_slice())
+        BoxSource::len(&self.as_slice())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
-        ReadBoxes::load(&self.as_slice(), i, count)
+        BoxSource::load(&self.as_slice(), i, count)
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
-        ReadBoxes::get(&self.as_slice(), i)
+        BoxSource::get(&self.as_slice(), i)
     }
     const AABB3S: bool = E::AABB3;
     fn aabb3s(&self) -> Option<&[Aabb3]> {
@@ -197,9 +197,9 @@ impl<'a, const N: usize, E: Boxes<N>> ReadBoxes<N> for &'a Vec<E> {
     }
 }
 
-impl<'a, const N: usize, E: Boxes<N>> WriteBoxes<N> for &'a mut Vec<E> {
+impl<'a, const N: usize, E: Boxes<N>> BoxSink<N> for &'a mut Vec<E> {
     fn len(&mut self) -> Result<usize, BatchError> {
-        WriteBoxes::len(&mut self.as_mut_slice())
+        BoxSink::len(&mut self.as_mut_slice())
     }
     type Read<'r>
         = &'r [E]
@@ -242,17 +242,17 @@ impl<'a, const N: usize, E: Boxes<N>> WriteBoxes<N> for &'a mut Vec<E> {
     }
 }
 
-impl<'a, const N: usize, E: Class<N>> ReadMaps<N> for &'a Vec<E> {
+impl<'a, const N: usize, E: Class<N>> TransformSource<N> for &'a Vec<E> {
     type Class = E;
     fn len(&self) -> Result<Option<usize>, BatchError> {
-        ReadMaps::len(&self.as_slice())
+        TransformSource::len(&self.as_slice())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> <Self::Class as Class<N>>::Lanes<L> {
-        ReadMaps::load(&self.as_slice(), i, count)
+        TransformSource::load(&self.as_slice(), i, count)
     }
     fn get(&self, i: usize) -> Self::Class {
-        ReadMaps::get(&self.as_slice(), i)
+        TransformSource::get(&self.as_slice(), i)
     }
     const MAPS: bool = true;
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {

@@ -7,7 +7,7 @@
 use alloc::vec::Vec;
 use glam::{Affine2, Affine3A};
 
-use super::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{BoxSink, BoxSource, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -202,7 +202,7 @@ impl<T: Fields> From<Block8<T>> for [T; 8] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
+impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[Block8<B>] {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(<[Block8<B>]>::len(self) * 8)
     }
@@ -225,7 +225,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &[Block8<B>] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
+impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [Block8<B>] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[Block8<B>]>::len(self) * 8)
     }
@@ -319,7 +319,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut [Block8<B>] {
     }
 }
 
-impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
+impl<const N: usize, T: Class<N>> TransformSource<N> for &[Block8<T>] {
     type Class = T;
     fn len(&self) -> Result<Option<usize>, BatchError> {
         Ok(Some(<[Block8<T>]>::len(self) * 8))
@@ -342,20 +342,20 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for &[Block8<T>] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
+impl<const N: usize, B: Boxes<N>> BoxSource<N> for &Vec<Block8<B>> {
     fn len(&self) -> Result<usize, BatchError> {
-        ReadBoxes::len(&self.as_slice())
+        BoxSource::len(&self.as_slice())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
-        ReadBoxes::load(&self.as_slice(), i, count)
+        BoxSource::load(&self.as_slice(), i, count)
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
-        ReadBoxes::get(&self.as_slice(), i)
+        BoxSource::get(&self.as_slice(), i)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
-        ReadBoxes::prefetch(&self.as_slice(), i);
+        BoxSource::prefetch(&self.as_slice(), i);
     }
     type Trimmed = Self;
     #[inline(always)]
@@ -364,9 +364,9 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for &Vec<Block8<B>> {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
+impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut Vec<Block8<B>> {
     fn len(&mut self) -> Result<usize, BatchError> {
-        WriteBoxes::len(&mut self.as_mut_slice())
+        BoxSink::len(&mut self.as_mut_slice())
     }
     type Read<'r>
         = &'r [Block8<B>]
@@ -415,21 +415,21 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for &mut Vec<Block8<B>> {
     }
 }
 
-impl<const N: usize, T: Class<N>> ReadMaps<N> for &Vec<Block8<T>> {
+impl<const N: usize, T: Class<N>> TransformSource<N> for &Vec<Block8<T>> {
     type Class = T;
     fn len(&self) -> Result<Option<usize>, BatchError> {
-        ReadMaps::len(&self.as_slice())
+        TransformSource::len(&self.as_slice())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> T::Lanes<L> {
-        ReadMaps::load(&self.as_slice(), i, count)
+        TransformSource::load(&self.as_slice(), i, count)
     }
     fn get(&self, i: usize) -> T {
-        ReadMaps::get(&self.as_slice(), i)
+        TransformSource::get(&self.as_slice(), i)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
-        ReadMaps::prefetch(&self.as_slice(), i);
+        TransformSource::prefetch(&self.as_slice(), i);
     }
     type Trimmed = Self;
     #[inline(always)]

@@ -4,7 +4,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::{ReadBoxes, ReadMaps, WriteBoxes};
+use super::{BoxSink, BoxSource, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -279,7 +279,7 @@ fn gather<L: LaneArray, T: Fields>(
     f
 }
 
-impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
+impl<const N: usize, B: Boxes<N>> BoxSource<N> for SoaRef<'_, B> {
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, len: usize) -> Self {
@@ -308,7 +308,7 @@ impl<const N: usize, B: Boxes<N>> ReadBoxes<N> for SoaRef<'_, B> {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
+impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, len: usize) -> Self {
@@ -376,7 +376,7 @@ impl<const N: usize, B: Boxes<N>> WriteBoxes<N> for SoaMut<'_, B> {
     }
 }
 
-impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
+impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
     type Class = T;
     type Trimmed = Self;
     #[inline(always)]
@@ -407,9 +407,9 @@ impl<const N: usize, T: Class<N>> ReadMaps<N> for SoaRef<'_, T> {
     }
 }
 
-impl<'a, const N: usize, E: Fields> ReadBoxes<N> for &'a Soa<E>
+impl<'a, const N: usize, E: Fields> BoxSource<N> for &'a Soa<E>
 where
-    SoaRef<'a, E>: ReadBoxes<N>,
+    SoaRef<'a, E>: BoxSource<N>,
 {
     type Trimmed = SoaRef<'a, E>;
     #[inline(always)]
@@ -417,25 +417,25 @@ where
         self.view().prefix(len)
     }
     fn len(&self) -> Result<usize, BatchError> {
-        ReadBoxes::len(&self.view())
+        BoxSource::len(&self.view())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> (Vector<L, N>, Vector<L, N>) {
-        ReadBoxes::load(&self.view(), i, count)
+        BoxSource::load(&self.view(), i, count)
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
-        ReadBoxes::get(&self.view(), i)
+        BoxSource::get(&self.view(), i)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
-        ReadBoxes::prefetch(&self.view(), i);
+        BoxSource::prefetch(&self.view(), i);
     }
 }
 
-impl<'a, const N: usize, E: Fields> WriteBoxes<N> for &'a mut Soa<E>
+impl<'a, const N: usize, E: Fields> BoxSink<N> for &'a mut Soa<E>
 where
-    for<'b> SoaMut<'b, E>: WriteBoxes<N>,
-    for<'b> SoaRef<'b, E>: ReadBoxes<N>,
+    for<'b> SoaMut<'b, E>: BoxSink<N>,
+    for<'b> SoaRef<'b, E>: BoxSource<N>,
 {
     type Trimmed = SoaMut<'a, E>;
     #[inline(always)]
@@ -443,7 +443,7 @@ where
         self.view_mut().prefix(len)
     }
     fn len(&mut self) -> Result<usize, BatchError> {
-        WriteBoxes::len(&mut self.view_mut())
+        BoxSink::len(&mut self.view_mut())
     }
     type Read<'r>
         = SoaRef<'r, E>
@@ -480,28 +480,28 @@ where
     }
 }
 
-impl<'a, const N: usize, E: Fields> ReadMaps<N> for &'a Soa<E>
+impl<'a, const N: usize, E: Fields> TransformSource<N> for &'a Soa<E>
 where
-    SoaRef<'a, E>: ReadMaps<N>,
+    SoaRef<'a, E>: TransformSource<N>,
 {
-    type Class = <SoaRef<'a, E> as ReadMaps<N>>::Class;
+    type Class = <SoaRef<'a, E> as TransformSource<N>>::Class;
     type Trimmed = SoaRef<'a, E>;
     #[inline(always)]
     fn trim(self, len: usize) -> SoaRef<'a, E> {
         self.view().prefix(len)
     }
     fn len(&self) -> Result<Option<usize>, BatchError> {
-        ReadMaps::len(&self.view())
+        TransformSource::len(&self.view())
     }
     #[inline(always)]
     fn load<L: LaneArray>(&self, i: usize, count: usize) -> <Self::Class as Class<N>>::Lanes<L> {
-        ReadMaps::load(&self.view(), i, count)
+        TransformSource::load(&self.view(), i, count)
     }
     fn get(&self, i: usize) -> Self::Class {
-        ReadMaps::get(&self.view(), i)
+        TransformSource::get(&self.view(), i)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
-        ReadMaps::prefetch(&self.view(), i);
+        TransformSource::prefetch(&self.view(), i);
     }
 }

@@ -13,7 +13,7 @@ pub use translation::{Translation2, Translation3};
 use crate::kernel::JoinLanes;
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Named3};
+pub(crate) use sealed::{Class, Maps, Named3};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -101,21 +101,30 @@ pub(crate) mod sealed {
     use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
 
-    /// Poses of a 3D class by name: how generic code reaches the code bvkit compiles once
-    /// per class (the AoS runs), so that a caller's crate compiles a call rather than the
-    /// loops.
+    /// Transforms read as AoS: one per box, or one shared.
+    #[derive(Clone, Copy)]
+    pub enum Maps<'a, T> {
+        /// Transform `k` for box `k`.
+        Each(&'a [T]),
+        /// One transform for every box.
+        Shared(&'a T),
+    }
+
+    /// AoS or shared poses of a 3D class, by name: how generic code reaches the code bvkit
+    /// compiles once per class (the AoS runs), so that a caller's crate compiles a call
+    /// rather than the loops.
     #[derive(Clone, Copy)]
     pub enum Named3<'a> {
         /// [`Translation3`] poses.
-        Translation3(&'a [Translation3]),
+        Translation3(Maps<'a, Translation3>),
         /// [`Rigid3`] poses.
-        Rigid3(&'a [Rigid3]),
+        Rigid3(Maps<'a, Rigid3>),
         /// [`Similarity3`] poses.
-        Similarity3(&'a [Similarity3]),
+        Similarity3(Maps<'a, Similarity3>),
         /// [`Trs3`] poses.
-        Trs3(&'a [Trs3]),
+        Trs3(Maps<'a, Trs3>),
         /// `Affine3A` poses.
-        Affine3A(&'a [glam::Affine3A]),
+        Affine3A(Maps<'a, glam::Affine3A>),
     }
 
     /// A transform class in `N` dimensions.
@@ -129,7 +138,7 @@ pub(crate) mod sealed {
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
         /// The poses by name: every 3D class, none of the 2D ones.
-        fn named(poses: &[Self]) -> Option<Named3<'_>>
+        fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>>
         where
             Self: Sized,
         {

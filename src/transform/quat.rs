@@ -7,7 +7,7 @@
 
 use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
-use super::{Class, Named3, Transform3};
+use super::{Class, Maps, Named3, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::{self, AffineLanes};
@@ -375,7 +375,7 @@ impl Fields for Trs3 {
 }
 
 impl Class<3> for Rigid3 {
-    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+    fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
         Some(Named3::Rigid3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
@@ -392,7 +392,7 @@ impl Class<3> for Rigid3 {
 }
 
 impl Class<3> for Similarity3 {
-    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+    fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
         Some(Named3::Similarity3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
@@ -410,7 +410,7 @@ impl Class<3> for Similarity3 {
 }
 
 impl Class<3> for Trs3 {
-    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+    fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
         Some(Named3::Trs3(poses))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;

@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
-use super::{Class, Named3, Transform2, Transform3};
+use super::{Class, Maps, Named3, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
@@ -132,7 +132,7 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
-    fn named(poses: &[Self]) -> Option<Named3<'_>> {
+    fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
         Some(Named3::Translation3(poses))
     }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
