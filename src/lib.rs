@@ -170,10 +170,10 @@ mod transform;
 pub mod tree;
 
 pub use aabb::{Aabb2, Aabb3};
-pub use batch::{Batch, LargePose, LargeRigid3, LargeWorld, Moved, Swept};
+pub use batch::{Batch, LargePose, LargeRigid3, LargeWorld, Swept};
 pub use engine::{Active, PoseSource};
 pub use error::{BatchError, TransformError};
-pub use fat::Margin;
+pub use fat::{Margin, Moved};
 pub use fit::{BoundingVolume, Capsule, Fit, FitError, Obb3, Sphere};
 pub use layout::{
     Aabb2Soa, Aabb2SoaMut, Aabb2SoaRef, Aabb2x8, Aabb3x8, AabbSoa, AabbSoaMut, AabbSoaRef,

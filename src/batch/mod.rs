@@ -4,14 +4,12 @@
 //! feature `rayon`).
 
 mod large;
-mod moved;
 #[cfg(feature = "rayon")]
 mod parallel;
 mod transform;
 mod update;
 
 pub use large::{LargePose, LargeRigid3};
-pub use moved::Moved;
 pub use update::{LargeWorld, Swept};
 
 #[cfg(doc)]

@@ -13,7 +13,7 @@ use core::marker::PhantomData;
 use glam::Vec3A;
 
 use super::active::{self, List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width};
-use super::{Active, Engine, PoseSource, Sink, Store};
+use super::{Active, AosSink, Engine, PoseSource, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::method::{Method, Rounding};
@@ -25,46 +25,6 @@ use crate::transform::{Maps, Named3, Rigid3, Similarity3, Transform3, Translatio
 /// masked update 1.1x at 1% and 10% active, AMD EPYC Zen 5.) An index list is walked one
 /// entry at a time.
 const SPAN: usize = 64;
-
-/// A sink the AoS loop can write: the lane loop's sink over AoS 3D boxes, which also takes
-/// the AoS loop's tight boxes, a chunk of [`CHUNK`] at a time or one. The loop computes a
-/// chunk into the slice the sink gives ([`AosSink::chunk`]), then hands it over
-/// ([`AosSink::take`]): the sink never calls back into the loop.
-pub(crate) trait AosSink: Sink<3> {
-    /// Where the tight boxes of objects `first..first + len` are computed (`len` at most
-    /// [`CHUNK`]): the output itself, or `scratch`.
-    fn chunk<'s>(
-        &'s mut self,
-        first: usize,
-        len: usize,
-        scratch: &'s mut [Aabb3; CHUNK],
-    ) -> &'s mut [Aabb3];
-    /// The tight boxes `tight` of objects `first..first + tight.len()`, computed where
-    /// [`AosSink::chunk`] said (`scratch` itself, where it said so), compared in groups
-    /// `P` of `W` boxes.
-    fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]);
-    /// Object `i` alone, with its tight box.
-    fn one(&mut self, i: usize, tight: Aabb3);
-}
-
-/// The plain sink on the AoS loop: every tight box written where it is computed.
-impl AosSink for Store<&mut [Aabb3]> {
-    #[inline(always)]
-    fn chunk<'s>(
-        &'s mut self,
-        first: usize,
-        len: usize,
-        _: &'s mut [Aabb3; CHUNK],
-    ) -> &'s mut [Aabb3] {
-        &mut self.out[first..first + len]
-    }
-    #[inline(always)]
-    fn take<const W: usize, P: BoxGroup<W>>(&mut self, _: usize, _: &[Aabb3]) {}
-    #[inline(always)]
-    fn one(&mut self, i: usize, tight: Aabb3) {
-        self.out[i] = tight;
-    }
-}
 
 /// The validity test of the AoS loop is taken once per this many objects.
 pub(crate) const CHUNK: usize = 64;
@@ -177,11 +137,11 @@ impl<'p, T> PoseList<'p, T> for &'p T {
 
 /// A run of the AoS loop, its lengths and its active set checked: everything but the
 /// poses.
-pub(crate) struct AosRun<'a, S> {
+pub(crate) struct AosRun<'a> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// Where the tight boxes go.
-    pub sink: S,
+    pub sink: AosSink<'a>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -190,18 +150,14 @@ pub(crate) struct AosRun<'a, S> {
     pub rounding: Rounding,
 }
 
-impl<S: AosSink> AosRun<'_, S> {
+impl AosRun<'_> {
     /// Runs over the active objects with `maps`, on a backend that [`takes_aos`]. Each walk
     /// is a job of its own, so that its loop has the dispatch wrapper's registers to
     /// itself: compiled beside the scattered walks, the loop over every object kept the
-    /// output pointer on the stack. A sink that takes every object ([`Sink::EVERY`])
-    /// compiles only that walk.
+    /// output pointer on the stack. The plain sink takes every object.
     #[inline(always)]
     pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
-        if S::EVERY {
-            debug_assert_eq!(self.active, Active::All);
-            return simd::dispatch_groups(backend, Every { run: self, maps });
-        }
+        debug_assert!(matches!(self.sink, AosSink::Fat(_)) || self.active == Active::All);
         match self.active {
             Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
             // A list's objects are scattered: they run in no group, compiled once for the
@@ -273,22 +229,22 @@ pub(crate) struct AosCall<'a> {
 
 impl AosCall<'_> {
     /// Runs into `sink`, with the poses in their class's type: the AoS loop, or on the
-    /// scalar backend the lane loop. Each sink calls it from one non-generic function of
-    /// its own, so that this code is compiled once, in bvkit, for the five classes.
-    #[inline(always)]
-    pub fn run<S: AosSink>(self, sink: S) {
+    /// scalar backend the lane loop. Neither generic nor inlined, so that this code is
+    /// compiled once, in bvkit, for the five classes and both sinks.
+    #[inline(never)]
+    pub fn run(self, sink: AosSink<'_>) {
         match self.poses {
-            Named3::Translation3(maps) => self.class::<Translation3, S>(maps, sink),
-            Named3::Rigid3(maps) => self.class::<Rigid3, S>(maps, sink),
-            Named3::Similarity3(maps) => self.class::<Similarity3, S>(maps, sink),
-            Named3::Trs3(maps) => self.class::<Trs3, S>(maps, sink),
-            Named3::Affine3A(maps) => self.class::<glam::Affine3A, S>(maps, sink),
+            Named3::Translation3(maps) => self.class::<Translation3>(maps, sink),
+            Named3::Rigid3(maps) => self.class::<Rigid3>(maps, sink),
+            Named3::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
+            Named3::Trs3(maps) => self.class::<Trs3>(maps, sink),
+            Named3::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
         }
     }
 
     /// [`AosCall::run`] with poses of class `T`. Not forced inline: in a debug build, the
     /// five classes' loops inlined into one function took a 1.3 MB stack frame.
-    fn class<T: Transform3, S: AosSink>(self, maps: Maps<'_, T>, sink: S) {
+    fn class<T: Transform3>(self, maps: Maps<'_, T>, sink: AosSink<'_>) {
         if takes_aos(self.backend) {
             let run = AosRun {
                 local: self.local,
@@ -300,12 +256,20 @@ impl AosCall<'_> {
             return run.run(maps, self.backend);
         }
         match maps {
-            Maps::Each(poses) => self.lanes(poses, sink),
-            Maps::Shared(pose) => self.lanes(pose, sink),
+            Maps::Each(poses) => self.sink(poses, sink),
+            Maps::Shared(pose) => self.sink(pose, sink),
         }
     }
 
-    /// The lane loop with `poses`, on the scalar backend.
+    /// The lane loop with `poses` into `sink`, on the scalar backend.
+    fn sink<P: PoseSource<3>>(self, poses: P, sink: AosSink<'_>) {
+        match sink {
+            AosSink::Store(out) => self.lanes(poses, Store { out, stream: false }),
+            AosSink::Fat(fat) => self.lanes(poses, fat),
+        }
+    }
+
+    /// The lane loop with `poses` into `sink`.
     fn lanes<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
         let engine = Engine {
             local: self.local,
@@ -349,12 +313,12 @@ macro_rules! each_kernel {
 }
 
 /// Every object.
-struct Every<'a, 'm, S, T> {
-    run: AosRun<'a, S>,
+struct Every<'a, 'm, T> {
+    run: AosRun<'a>,
     maps: Maps<'m, T>,
 }
 
-impl<S: AosSink, T: Transform3> GroupJob for Every<'_, '_, S, T> {
+impl<T: Transform3> GroupJob for Every<'_, '_, T> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
         each_kernel!(self.run, self.maps, W, P, whole);
@@ -363,16 +327,14 @@ impl<S: AosSink, T: Transform3> GroupJob for Every<'_, '_, S, T> {
 
 /// The objects of an index list or a mask: `A`, a [`Subset`] of one kind, in spans of
 /// `Sp`.
-struct Scattered<'a, 'm, S, T, A, Sp> {
-    run: AosRun<'a, S>,
+struct Scattered<'a, 'm, T, A, Sp> {
+    run: AosRun<'a>,
     maps: Maps<'m, T>,
     set: A,
     width: PhantomData<Sp>,
 }
 
-impl<S: AosSink, T: Transform3, A: Subset, Sp: SpanWidth> GroupJob
-    for Scattered<'_, '_, S, T, A, Sp>
-{
+impl<T: Transform3, A: Subset, Sp: SpanWidth> GroupJob for Scattered<'_, '_, T, A, Sp> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
         each_kernel!(self.run, self.maps, W, P, scattered, (self.set, self.width));
@@ -381,8 +343,8 @@ impl<S: AosSink, T: Transform3, A: Subset, Sp: SpanWidth> GroupJob
 
 /// [`Every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
-    run: AosRun<'_, S>,
+fn whole<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
+    run: AosRun<'_>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
 ) {
@@ -395,8 +357,8 @@ fn whole<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
 /// Objects `start..start + local.len()`, every one active, `start` a multiple of [`CHUNK`]:
 /// their tight boxes into the sink a chunk at a time.
 #[inline(always)]
-fn chunks<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
-    sink: &mut S,
+fn chunks<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
+    sink: &mut AosSink<'_>,
     start: usize,
     local: &[Aabb3],
     poses: impl PoseList<'p, T>,
@@ -419,8 +381,8 @@ fn chunks<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>>(
 /// vector, with the validity test per chunk ([`Tight::boxes`]), and the objects of other
 /// spans one at a time.
 #[inline(always)]
-fn scattered<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>, Sp: SpanWidth>(
-    run: AosRun<'_, S>,
+fn scattered<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>, Sp: SpanWidth>(
+    run: AosRun<'_>,
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
     (set, _): (impl Subset, PhantomData<Sp>),
@@ -437,18 +399,17 @@ fn scattered<'p, T: Transform3 + 'p, S: AosSink, const W: usize, P: BoxGroup<W>,
 }
 
 /// The AoS loop's visit of a scattered active set.
-struct Objects<'a, 'p, S, Q, T, G> {
+struct Objects<'a, 'p, Q, T, G> {
     local: &'a [Aabb3],
-    sink: S,
+    sink: AosSink<'a>,
     poses: Q,
     tight: G,
     class: PhantomData<fn() -> &'p T>,
 }
 
-impl<'p, T, S, Q, const W: usize, P> Visit for Objects<'_, 'p, S, Q, T, Tight<P, W>>
+impl<'p, T, Q, const W: usize, P> Visit for Objects<'_, 'p, Q, T, Tight<P, W>>
 where
     T: Transform3 + 'p,
-    S: AosSink,
     Q: PoseList<'p, T>,
     P: BoxGroup<W>,
 {

@@ -45,23 +45,24 @@ macro_rules! specialise {
 
 mod active;
 mod aos;
+mod sink;
 
 pub use active::Active;
 #[cfg(feature = "rayon")]
 pub(crate) use aos::window;
-pub(crate) use aos::{AosCall, AosSink, CHUNK};
+pub(crate) use aos::{AosCall, CHUNK};
+pub(crate) use sink::{AosSink, Fat, Sink, Store};
 
 use active::{
     List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width, dense, mask_of,
 };
 use core::marker::PhantomData;
 
-use crate::aabb::Aabb3;
 use crate::error::BatchError;
 use crate::extended;
 use crate::kernel;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, TransformSource};
+use crate::layout::{BoxSource, TransformSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
 use crate::transform::{Class, Named3};
@@ -212,120 +213,6 @@ fn tight_one<const N: usize, B: BoxSource<N>, P: PoseSource<N>>(
 ) -> [[f32; N]; 2] {
     let (lo, hi) = local.get(i);
     poses.tight_one(i, lo, hi, method, rounding)
-}
-
-/// Where the lane loop's tight boxes go.
-pub(crate) trait Sink<const N: usize> {
-    /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
-    /// `lanes` bits are active. Where `redo` is nonzero the lane's box does not stand and
-    /// must be replaced by `extended.tight(i + k)`, its box on the extended path.
-    fn span<L: LaneArray>(
-        &mut self,
-        i: usize,
-        count: usize,
-        lanes: u64,
-        tight: [Vector<L, N>; 2],
-        redo: L,
-        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
-    );
-    /// Asks for object `i`'s output ahead of a scattered access.
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        let _ = i;
-    }
-    /// After the last span (a fence after streaming stores).
-    fn finish(&mut self) {}
-    /// True when the sink takes every object ([`Active::All`]), as a batch transform's
-    /// does: its runs then compile only that walk (a third of the loops otherwise).
-    const EVERY: bool = false;
-    /// True when the sink writes AoS 3D boxes, and [`Sink::run_aos`] takes them.
-    const AABB3S: bool = false;
-    /// The run `call` into this sink, where it writes AoS 3D boxes ([`Sink::AABB3S`]): a
-    /// call to a non-generic function of the sink's that runs [`AosCall::run`], so that a
-    /// generic call site compiles none of it.
-    fn run_aos(self, call: AosCall<'_>);
-    /// The same sink, as the loop writes it.
-    type Trimmed: Sink<N>;
-    /// The sink for the first `len` objects, every slice cut to that length (see
-    /// [`BoxSource::trim`](crate::layout::BoxSource::trim)).
-    fn trim(self, len: usize) -> Self::Trimmed;
-}
-
-/// The plain sink: every tight box written to `out`, past the caches when `stream` is set.
-pub(crate) struct Store<O> {
-    /// The boxes written.
-    pub out: O,
-    /// Store whole AoSoA blocks past the caches, and fence at the end.
-    pub stream: bool,
-}
-
-impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
-    #[inline(always)]
-    fn span<L: LaneArray>(
-        &mut self,
-        i: usize,
-        count: usize,
-        lanes: u64,
-        [min, max]: [Vector<L, N>; 2],
-        redo: L,
-        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
-    ) {
-        // Every object is active: a store writes whole spans.
-        debug_assert_eq!(lanes.count_ones() as usize, count);
-        if self.stream {
-            self.out.store_streaming(i, count, min, max);
-        } else {
-            self.out.store(i, count, min, max);
-        }
-        // The rare lanes that do not stand are recomputed from the source data. The branch
-        // is marked cold, so that the registers go to the common path (an in-cache SoA
-        // rigid batch ran up to 1.15x slower without the hint); and nothing here takes
-        // `&mut self` out of line, so the layout descriptors stay in registers (calling
-        // out of line with them cost an in-cache AoSoA translation batch 1.1-1.35x; both
-        // measured on an Intel Xeon).
-        if redo.any_nonzero() {
-            core::hint::cold_path();
-            for k in 0..count {
-                if redo.get(k) != 0.0 {
-                    let [min, max] = extended.tight(i + k);
-                    self.out.set(i + k, min, max);
-                }
-            }
-        }
-    }
-    fn finish(&mut self) {
-        if self.stream {
-            simd::store_fence();
-        }
-    }
-    const EVERY: bool = true;
-    const AABB3S: bool = O::AABB3S;
-    fn run_aos(mut self, call: AosCall<'_>) {
-        let Some(out) = self.out.aabb3s_mut() else {
-            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
-        };
-        store_aos(
-            call,
-            Store {
-                out,
-                stream: self.stream,
-            },
-        );
-    }
-    type Trimmed = Store<O::Trimmed>;
-    #[inline(always)]
-    fn trim(self, len: usize) -> Store<O::Trimmed> {
-        Store {
-            out: self.out.trim(len),
-            stream: self.stream,
-        }
-    }
-}
-
-/// [`Sink::run_aos`] of the plain sink: compiled here, once.
-#[inline(never)]
-fn store_aos(call: AosCall<'_>, sink: Store<&mut [Aabb3]>) {
-    call.run(sink);
 }
 
 /// One run of the engine, its lengths and its active set checked.

@@ -1,5 +1,10 @@
-//! Fat boxes: a tight box grown by a margin and rounded outward, and the test that a tight
-//! box still lies inside one.
+//! Fat boxes: a tight box grown by a margin and rounded outward, the test that a tight
+//! box still lies inside one, and the set of objects whose fat box an update rewrote
+//! (`moved`).
+
+mod moved;
+
+pub use moved::Moved;
 
 use crate::aabb::{Aabb2, Aabb3};
 use crate::lane::{Lane, Vector};

@@ -1,0 +1,383 @@
+//! The sinks of a run: where its tight boxes go. [`Store`] writes them (the batch
+//! transform); [`Fat`] compares each with its fat box, rewrites the fat boxes they left and
+//! records their objects (the broadphase update). The lane loop takes any [`Sink`]; the AoS
+//! loop takes the two as one [`AosSink`].
+
+use super::{AosCall, CHUNK, Extended, PoseSource};
+use crate::aabb::Aabb3;
+use crate::fat::{Margin, Moved};
+use crate::kernel::gather;
+use crate::lane::Vector;
+use crate::layout::{BoxSink, BoxSource};
+use crate::simd::{self, BoxGroup, LaneArray};
+
+/// Where the lane loop's tight boxes go.
+pub(crate) trait Sink<const N: usize> {
+    /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
+    /// `lanes` bits are active. Where `redo` is nonzero the lane's box does not stand and
+    /// must be replaced by `extended.tight(i + k)`, its box on the extended path.
+    fn span<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        tight: [Vector<L, N>; 2],
+        redo: L,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
+    );
+    /// Asks for object `i`'s output ahead of a scattered access.
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        let _ = i;
+    }
+    /// After the last span (a fence after streaming stores).
+    fn finish(&mut self) {}
+    /// True when the sink takes every object ([`Active::All`]), as a batch transform's
+    /// does: its runs then compile only that walk (a third of the loops otherwise).
+    const EVERY: bool = false;
+    /// True when the sink writes AoS 3D boxes, and [`Sink::run_aos`] takes them.
+    const AABB3S: bool = false;
+    /// The run `call` into this sink, where it writes AoS 3D boxes ([`Sink::AABB3S`]): the
+    /// sink as an [`AosSink`] handed to [`AosCall::run`], which bvkit compiles once, so
+    /// that a generic call site compiles none of it.
+    fn run_aos(self, call: AosCall<'_>);
+    /// The same sink, as the loop writes it.
+    type Trimmed: Sink<N>;
+    /// The sink for the first `len` objects, every slice cut to that length (see
+    /// [`BoxSource::trim`](crate::layout::BoxSource::trim)).
+    fn trim(self, len: usize) -> Self::Trimmed;
+}
+
+/// The plain sink: every tight box written to `out`, past the caches when `stream` is set.
+pub(crate) struct Store<O> {
+    /// The boxes written.
+    pub out: O,
+    /// Store whole AoSoA blocks past the caches, and fence at the end.
+    pub stream: bool,
+}
+
+impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
+    #[inline(always)]
+    fn span<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        [min, max]: [Vector<L, N>; 2],
+        redo: L,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
+    ) {
+        // Every object is active: a store writes whole spans.
+        debug_assert_eq!(lanes.count_ones() as usize, count);
+        if self.stream {
+            self.out.store_streaming(i, count, min, max);
+        } else {
+            self.out.store(i, count, min, max);
+        }
+        // The rare lanes that do not stand are recomputed from the source data. The branch
+        // is marked cold, so that the registers go to the common path (an in-cache SoA
+        // rigid batch ran up to 1.15x slower without the hint); and nothing here takes
+        // `&mut self` out of line, so the layout descriptors stay in registers (calling
+        // out of line with them cost an in-cache AoSoA translation batch 1.1-1.35x; both
+        // measured on an Intel Xeon).
+        if redo.any_nonzero() {
+            core::hint::cold_path();
+            for k in 0..count {
+                if redo.get(k) != 0.0 {
+                    let [min, max] = extended.tight(i + k);
+                    self.out.set(i + k, min, max);
+                }
+            }
+        }
+    }
+    fn finish(&mut self) {
+        if self.stream {
+            simd::store_fence();
+        }
+    }
+    const EVERY: bool = true;
+    const AABB3S: bool = O::AABB3S;
+    fn run_aos(mut self, call: AosCall<'_>) {
+        let Some(out) = self.out.aabb3s_mut() else {
+            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        };
+        call.run(AosSink::Store(out));
+    }
+    type Trimmed = Store<O::Trimmed>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Store<O::Trimmed> {
+        Store {
+            out: self.out.trim(len),
+            stream: self.stream,
+        }
+    }
+}
+
+/// The update's sink: each tight box compared with its fat box, the fat boxes it left
+/// rewritten, and their objects recorded.
+pub(crate) struct Fat<'a, F> {
+    /// The fat boxes.
+    pub fat: F,
+    /// How much a rewritten fat box exceeds its tight box.
+    pub margin: Margin,
+    /// The objects whose fat box was rewritten.
+    pub moved: &'a mut Moved,
+}
+
+impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
+    #[inline(always)]
+    fn span<L: LaneArray>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        tight: [Vector<L, N>; 2],
+        redo: L,
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
+    ) {
+        let (fat_min, fat_max) = self.fat.read().load::<L>(i, count);
+        let outside = crate::fat::outside(tight[0], tight[1], fat_min, fat_max);
+        // The common case, every box inside its fat box and standing: one reduction.
+        if !(outside + redo).any_nonzero() {
+            return;
+        }
+        self.rewrite(
+            i,
+            count,
+            lanes,
+            [outside.portable(), redo.portable()],
+            tight.map(L::portable_vector),
+            [fat_min, fat_max].map(L::portable_vector),
+            extended,
+        );
+    }
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        self.fat.read().prefetch(i);
+    }
+    const AABB3S: bool = F::AABB3S;
+    fn run_aos(mut self, call: AosCall<'_>) {
+        let Some(fat) = self.fat.aabb3s_mut() else {
+            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        };
+        let (margin, moved) = (self.margin, self.moved);
+        call.run(AosSink::Fat(Fat { fat, margin, moved }));
+    }
+    type Trimmed = Fat<'a, F::Trimmed>;
+    #[inline(always)]
+    fn trim(self, len: usize) -> Self::Trimmed {
+        Fat {
+            fat: self.fat.trim(len),
+            margin: self.margin,
+            moved: self.moved,
+        }
+    }
+}
+
+impl<F> Fat<'_, F> {
+    /// The rest of a span where a box left its fat box or did not stand: the fat boxes
+    /// rewritten and the objects recorded. Out of line: inlined, its code (though rarely
+    /// run) made LLVM spill the hot path, which then ran three times slower. It uses no
+    /// multiply-add, so it needs none of the dispatcher's target features, and it takes
+    /// the portable lanes ([`LaneArray::Portable`]), which code compiled without them can
+    /// hold.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn rewrite<L: LaneArray, const N: usize>(
+        &mut self,
+        i: usize,
+        count: usize,
+        lanes: u64,
+        [outside, redo]: [L; 2],
+        [min, max]: [Vector<L, N>; 2],
+        [fat_min, fat_max]: [Vector<L, N>; 2],
+        extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
+    ) where
+        F: BoxSink<N>,
+    {
+        let redo_lanes = u64::from(redo.nonzero_mask()) & lanes;
+        let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
+        if left != 0 && lanes != u64::MAX >> (64 - count) {
+            // A span shared with inactive objects: only the boxes rewritten are stored, so
+            // that an inactive object's fat box is never written.
+            let (grown_min, grown_max) = self.margin.grow(min, max);
+            let mut bits = left;
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                let lane = |v: &Vector<L, N>| v.0.map(|x| x.get(k));
+                self.fat.set(i + k, lane(&grown_min), lane(&grown_max));
+                bits &= bits - 1;
+            }
+        } else if left != 0 {
+            // Every object of the span is active: the whole span is stored, the lanes that
+            // stay with their own bits. Lanes picked by a dynamic index would pin the
+            // vectors to memory and stop LLVM from vectorising the span.
+            let (grown_min, grown_max) = self.margin.grow(min, max);
+            // Negative where the box is rewritten. `outside` is 0 where a box stays and at
+            // least 1 where it left, so where every lane is active and stands its negation
+            // is the mask; otherwise it is built lane by lane.
+            let keep = if left == u64::from(outside.nonzero_mask()) {
+                -outside
+            } else {
+                let mut keep = L::splat(0.0);
+                for k in 0..L::WIDTH {
+                    keep.set(k, if left >> k & 1 != 0 { -1.0 } else { 0.0 });
+                }
+                keep
+            };
+            let (mut min, mut max) = (fat_min, fat_max);
+            for a in 0..N {
+                min.0[a] = keep.select_nonneg(fat_min.0[a], grown_min.0[a]);
+                max.0[a] = keep.select_nonneg(fat_max.0[a], grown_max.0[a]);
+            }
+            self.fat.store(i, count, min, max);
+        }
+        let mut moved = left;
+        let mut bits = redo_lanes;
+        while bits != 0 {
+            let k = bits.trailing_zeros() as usize;
+            if self.leaves(i + k, extended.tight(i + k)) {
+                moved |= 1 << k;
+            }
+            bits &= bits - 1;
+        }
+        self.moved.record(i, moved);
+    }
+
+    /// True when object `i`'s tight box from the extended path leaves its fat box, which
+    /// is then rewritten.
+    #[cold]
+    fn leaves<const N: usize>(&mut self, i: usize, tight: [[f32; N]; 2]) -> bool
+    where
+        F: BoxSink<N>,
+    {
+        if crate::fat::inside(tight, self.fat.read().get(i).into()) {
+            return false;
+        }
+        let (min, max) = self
+            .margin
+            .grow::<f32, N>(Vector(tight[0]), Vector(tight[1]));
+        self.fat.set(i, min.0, max.0);
+        true
+    }
+}
+
+/// The fat sink on the AoS loop.
+impl Fat<'_, &mut [Aabb3]> {
+    /// Sixty-four objects at a time: per group of `W` the test against the fat boxes in
+    /// registers ([`BoxGroup::le_xyz`]), and where a box of the group left its fat box, the
+    /// group's fat boxes stored with the grown boxes picked in ([`BoxGroup::pick`]): the
+    /// others keep their bits. A branch per object would mispredict on every object a walk
+    /// moves at random. The objects are recorded once per 64. (Eight at a time, with the
+    /// test and the growth one box after the other, the update of 16K bodies, all awake,
+    /// ran at 1.83x the naive rewrite, against 1.65x now, Intel Xeon with AVX-512: the
+    /// kernel is most of both. Compared as each group is computed, without the chunk, it
+    /// ran as fast, AMD EPYC Zen 5.)
+    #[inline(always)]
+    fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]) {
+        debug_assert_eq!(first % 64, 0, "a chunk starts on a word of the moved set");
+        let every = u32::MAX >> (32 - W);
+        let fat = &mut self.fat[first..first + tight.len()];
+        let mut left = 0;
+        let groups = tight.chunks_exact(W).zip(fat.chunks_exact_mut(W));
+        for (g, (tight, fat)) in groups.enumerate() {
+            let (min, max) = (
+                P::join(gather(|k| tight[k].min)),
+                P::join(gather(|k| tight[k].max)),
+            );
+            let fat_min = P::join(gather(|k| fat[k].min));
+            let fat_max = P::join(gather(|k| fat[k].max));
+            let inside = P::le_xyz(fat_min, min) & P::le_xyz(max, fat_max);
+            if inside != every {
+                let (grown_min, grown_max) = self.margin.grow::<P, 1>(Vector([min]), Vector([max]));
+                let min = P::pick(inside, fat_min, grown_min.0[0]).parts();
+                let max = P::pick(inside, fat_max, grown_max.0[0]).parts();
+                for (k, fat) in fat.iter_mut().enumerate() {
+                    *fat = Aabb3 {
+                        min: min[k],
+                        max: max[k],
+                    };
+                }
+            }
+            left |= u64::from(!inside & every) << (g * W);
+        }
+        for k in tight.len() - tight.len() % W..tight.len() {
+            left |= u64::from(!keep(&mut fat[k], tight[k], self.margin)) << k;
+        }
+        self.moved.record(first, left);
+    }
+    #[inline(always)]
+    fn one(&mut self, i: usize, tight: Aabb3) {
+        if !keep(&mut self.fat[i], tight, self.margin) {
+            self.moved.record(i, 1);
+        }
+    }
+}
+
+/// One object of the AoS loop: true when its tight box lies inside its fat box; otherwise
+/// the fat box becomes the tight box fattened.
+#[inline(always)]
+fn keep(fat: &mut Aabb3, tight: Aabb3, margin: Margin) -> bool {
+    let inside = crate::fat::inside_aabb3(&tight, fat);
+    if !inside {
+        *fat = tight.fattened(margin);
+    }
+    inside
+}
+
+/// The sink of the AoS loop: the plain sink over AoS 3D boxes, or the fat sink. One type,
+/// so that bvkit compiles the AoS loop once per class for both; the loop matches it once
+/// per chunk of [`CHUNK`] objects, or per object of a scattered span. The loop computes a
+/// chunk into the slice the sink gives ([`AosSink::chunk`]), then hands it over
+/// ([`AosSink::take`]): the sink never calls back into the loop.
+pub(crate) enum AosSink<'a> {
+    /// Every tight box written where it is computed.
+    Store(&'a mut [Aabb3]),
+    /// Each tight box compared with its fat box.
+    Fat(Fat<'a, &'a mut [Aabb3]>),
+}
+
+impl AosSink<'_> {
+    /// Where the tight boxes of objects `first..first + len` are computed (`len` at most
+    /// [`CHUNK`]): the output itself, or `scratch`.
+    #[inline(always)]
+    pub fn chunk<'s>(
+        &'s mut self,
+        first: usize,
+        len: usize,
+        scratch: &'s mut [Aabb3; CHUNK],
+    ) -> &'s mut [Aabb3] {
+        match self {
+            AosSink::Store(out) => &mut out[first..first + len],
+            AosSink::Fat(_) => &mut scratch[..len],
+        }
+    }
+
+    /// The tight boxes `tight` of objects `first..first + tight.len()`, computed where
+    /// [`AosSink::chunk`] said (`scratch` itself, where it said so), compared in groups
+    /// `P` of `W` boxes.
+    #[inline(always)]
+    pub fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]) {
+        if let AosSink::Fat(fat) = self {
+            fat.take::<W, P>(first, tight);
+        }
+    }
+
+    /// Object `i` alone, with its tight box.
+    #[inline(always)]
+    pub fn one(&mut self, i: usize, tight: Aabb3) {
+        match self {
+            AosSink::Store(out) => out[i] = tight,
+            AosSink::Fat(fat) => fat.one(i, tight),
+        }
+    }
+
+    /// Asks for object `i`'s output ahead of a scattered access.
+    #[inline(always)]
+    pub fn prefetch(&self, i: usize) {
+        // The plain sink takes every object, in order: only the fat sink is scattered.
+        if let AosSink::Fat(fat) = self {
+            simd::prefetch(&fat.fat[i]);
+        }
+    }
+}
