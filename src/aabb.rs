@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3A};
 
-use crate::fields::{Fields, MAX_FIELDS};
+use crate::fields::{Block8, Fields, MAX_FIELDS};
 
 /// An axis-aligned box in 3D, `min <= p <= max`.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -222,9 +222,10 @@ impl Fields for Aabb2 {
 
 /// A box type of `N` dimensions: its fields are `min` then `max`.
 pub(crate) trait Boxes<const N: usize>: Fields {
-    /// True when this is [`Aabb3`], whose slices [`Boxes::aabb3s`] returns.
+    /// True when this is [`Aabb3`], whose slices and blocks the hooks below return: the
+    /// boxes of the runs bvkit compiles once (`layout::Route`).
     const AABB3: bool = false;
-    /// The slice as 3D boxes, when it is one (for the paired AoS path).
+    /// The slice as 3D boxes, when it is one.
     fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
         let _ = items;
         None
@@ -232,6 +233,16 @@ pub(crate) trait Boxes<const N: usize>: Fields {
     /// The mutable slice as 3D boxes, when it is one.
     fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
         let _ = items;
+        None
+    }
+    /// The blocks as blocks of 3D boxes, when they are.
+    fn aabb3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Aabb3>]> {
+        let _ = blocks;
+        None
+    }
+    /// The mutable blocks as blocks of 3D boxes, when they are.
+    fn aabb3x8s_mut(blocks: &mut [Block8<Self>]) -> Option<&mut [Block8<Aabb3>]> {
+        let _ = blocks;
         None
     }
 }
@@ -242,6 +253,12 @@ impl Boxes<3> for Aabb3 {
     }
     fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
         Some(items)
+    }
+    fn aabb3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Aabb3>]> {
+        Some(blocks)
+    }
+    fn aabb3x8s_mut(blocks: &mut [Block8<Self>]) -> Option<&mut [Block8<Aabb3>]> {
+        Some(blocks)
     }
 }
 impl Boxes<2> for Aabb2 {}

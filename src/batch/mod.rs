@@ -144,8 +144,9 @@ mod tests {
     use super::*;
     use crate::aabb::Aabb3;
     use crate::engine::{Active, Engine, Store};
-    use crate::layout::{Aabb3x8, Block8, TransformSource};
+    use crate::layout::{Aabb3x8, Block8, Boxes3, Boxes3Mut, Route, TransformSource};
     use crate::simd::{F32s, LaneArray};
+    use crate::transform::Named3;
     use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
@@ -204,28 +205,66 @@ mod tests {
                 .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
     }
 
-    /// Layouts whose types say they are AoS 3D boxes with AoS or shared poses.
-    fn aos<B: BoxSource<3>, X: PoseSource<3>, O: BoxSink<3>>(local: B, xf: X, mut out: O) {
-        assert!(Engine::<3, B, X, Store<O>>::AOS);
-        assert!(local.aabb3s().is_some() && xf.aos().is_some() && out.aabb3s_mut().is_some());
+    /// The route the layouts' types name: where it is not generic, every source and the
+    /// output name themselves for it (so the `unreachable!`s of [`Engine::run`], of the
+    /// sinks' `run_named` and of `NamedCall` are never reached), with the kind it says.
+    fn route<B: BoxSource<3>, X: PoseSource<3>, O: BoxSink<3>>(
+        local: B,
+        xf: X,
+        mut out: O,
+    ) -> Route {
+        let route = Engine::<3, B, X, Store<O>>::ROUTE;
+        let named = (local.named(), xf.named(), out.named_mut());
+        match route {
+            Route::Generic => {}
+            Route::Aos => assert!(matches!(
+                named,
+                (Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_)))
+                    if !matches!(p, Named3::Rigid3x8(_))
+            )),
+            Route::Blocks => assert!(matches!(
+                named,
+                (
+                    Some(Boxes3::Blocks(_)),
+                    Some(Named3::Rigid3x8(_)),
+                    Some(Boxes3Mut::Blocks(_))
+                )
+            )),
+        }
+        route
     }
 
-    /// Every layout whose constants send a run to the AoS loop converts to it: the
-    /// `unreachable!`s of [`Engine::run`] and of the sinks' `run_aos` are never reached.
+    /// Every layout whose constants name a route converts to it; the others take none.
     #[test]
-    fn aos_layouts_always_convert() {
-        let local = vec![Aabb3::EMPTY; 3];
-        let mut out = vec![Aabb3::NAN; 3];
-        let (rigid, affine) = (vec![Rigid3::IDENTITY; 3], vec![Affine3A::IDENTITY; 3]);
-        aos(&local[..], &rigid[..], &mut out[..]);
-        aos(&local, &rigid, &mut out);
-        aos(&local[..], &rigid[0], &mut out[..]);
-        aos(&local, &affine, &mut out);
-        aos(&local, &Trs3::IDENTITY, &mut out);
-        aos(&local, &[Similarity3::IDENTITY; 3][..], &mut out);
-        aos(&local, &[Translation3::IDENTITY; 3][..], &mut out);
-        type Blocks<'a> = Engine<'a, 3, &'a [Block8<Aabb3>], &'a [Rigid3], Store<&'a mut [Aabb3]>>;
-        const { assert!(!Blocks::AOS) };
+    fn routes_always_convert() {
+        let local = vec![Aabb3::EMPTY; 16];
+        let mut out = vec![Aabb3::NAN; 16];
+        let (rigid, affine) = (vec![Rigid3::IDENTITY; 16], vec![Affine3A::IDENTITY; 16]);
+        assert_eq!(route(&local[..], &rigid[..], &mut out[..]), Route::Aos);
+        assert_eq!(route(&local, &rigid, &mut out), Route::Aos);
+        assert_eq!(route(&local[..], &rigid[0], &mut out[..]), Route::Aos);
+        assert_eq!(route(&local, &affine, &mut out), Route::Aos);
+        assert_eq!(route(&local, &Trs3::IDENTITY, &mut out), Route::Aos);
+        assert_eq!(
+            route(&local, &[Similarity3::IDENTITY; 16][..], &mut out),
+            Route::Aos
+        );
+        assert_eq!(
+            route(&local, &[Translation3::IDENTITY; 16][..], &mut out),
+            Route::Aos
+        );
+        let (l8, r8) = (Block8::pack(&local), Block8::pack(&rigid));
+        let mut o8 = vec![Aabb3x8::default(); 2];
+        assert_eq!(route(&l8[..], &r8[..], &mut o8[..]), Route::Blocks);
+        assert_eq!(route(&l8, &r8, &mut o8), Route::Blocks);
+        // Not compiled in bvkit: other classes in blocks, shared poses with blocks, mixed
+        // layouts.
+        let a8: Vec<Block8<Affine3A>> = Block8::pack(&affine);
+        assert_eq!(route(&l8, &a8, &mut o8), Route::Generic);
+        assert_eq!(route(&l8, &rigid[0], &mut o8), Route::Generic);
+        assert_eq!(route(&l8, &r8, &mut out), Route::Generic);
+        assert_eq!(route(&local, &r8, &mut out), Route::Generic);
+        assert_eq!(route(&local, &rigid, &mut o8), Route::Generic);
     }
 
     #[test]

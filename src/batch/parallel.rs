@@ -12,12 +12,11 @@ use rayon::prelude::*;
 
 use super::update::check_update;
 use super::{Batch, checked_len};
-use crate::aabb::Aabb3;
 use crate::engine::{Active, PoseSource, window};
 use crate::error::BatchError;
 use crate::fat::{Margin, Moved};
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource};
+use crate::layout::{BoxSink, BoxSource, Boxes3, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::LaneArray;
 use crate::transform::Named3;
@@ -50,9 +49,16 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
         self.src.get(self.start + i)
     }
     // A window lies inside its source: the range below is always in bounds.
-    const AABB3S: bool = S::AABB3S;
-    fn aabb3s(&self) -> Option<&[Aabb3]> {
-        self.src.aabb3s()?.get(self.start..self.start + self.len)
+    // Only AoS windows keep their route.
+    const ROUTE: Route = match S::ROUTE {
+        Route::Aos => Route::Aos,
+        _ => Route::Generic,
+    };
+    fn named(&self) -> Option<Boxes3<'_>> {
+        match self.src.named()? {
+            Boxes3::Aos(boxes) => Some(Boxes3::Aos(boxes.get(self.start..self.start + self.len)?)),
+            Boxes3::Blocks(_) => None,
+        }
     }
     type Trimmed = Self;
     #[inline(always)]
@@ -93,9 +99,12 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
     fn prefetch(&self, i: usize) {
         self.src.prefetch(self.start + i);
     }
-    const AOS: bool = S::AOS;
-    fn aos(&self) -> Option<Named3<'_>> {
-        window(self.src.aos()?, self.start, self.len)
+    const ROUTE: Route = match S::ROUTE {
+        Route::Aos => Route::Aos,
+        _ => Route::Generic,
+    };
+    fn named(&self) -> Option<Named3<'_>> {
+        window(self.src.named()?, self.start, self.len)
     }
     type Trimmed = Self;
     #[inline(always)]

@@ -205,6 +205,7 @@ pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Name
         Named3::Similarity3(p) => Named3::Similarity3(part(p, start, len)?),
         Named3::Trs3(p) => Named3::Trs3(part(p, start, len)?),
         Named3::Affine3A(p) => Named3::Affine3A(part(p, start, len)?),
+        Named3::Rigid3x8(_) => return None,
     })
 }
 
@@ -229,9 +230,9 @@ pub(crate) struct AosCall<'a> {
 
 impl AosCall<'_> {
     /// Runs into `sink`, with the poses in their class's type: the AoS loop, or on the
-    /// scalar backend the lane loop. Neither generic nor inlined, so that this code is
-    /// compiled once, in bvkit, for the five classes and both sinks.
-    #[inline(never)]
+    /// scalar backend the lane loop. Called from one function only, which is neither
+    /// generic nor inlined ([`super::NamedCall::aos`]).
+    #[inline(always)]
     pub fn run(self, sink: AosSink<'_>) {
         match self.poses {
             Named3::Translation3(maps) => self.class::<Translation3>(maps, sink),
@@ -239,6 +240,7 @@ impl AosCall<'_> {
             Named3::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
             Named3::Trs3(maps) => self.class::<Trs3>(maps, sink),
             Named3::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
+            Named3::Rigid3x8(_) => unreachable!("blocks of poses take the blocks' route"),
         }
     }
 

@@ -45,12 +45,14 @@ macro_rules! specialise {
 
 mod active;
 mod aos;
+mod named;
 mod sink;
 
 pub use active::Active;
 #[cfg(feature = "rayon")]
 pub(crate) use aos::window;
 pub(crate) use aos::{AosCall, CHUNK};
+pub(crate) use named::{BlockSink, NamedCall};
 pub(crate) use sink::{AosSink, Fat, Sink, Store};
 
 use active::{
@@ -62,7 +64,7 @@ use crate::error::BatchError;
 use crate::extended;
 use crate::kernel;
 use crate::lane::Vector;
-use crate::layout::{BoxSource, TransformSource};
+use crate::layout::{BoxSource, Route, TransformSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
 use crate::transform::{Class, Named3};
@@ -107,13 +109,12 @@ pub trait PoseSource<const N: usize> {
         let _ = i;
     }
     #[doc(hidden)]
-    /// True when [`PoseSource::aos`] always returns the poses, given 3D boxes (AoS or shared
-    /// transforms).
-    const AOS: bool = false;
+    /// The run of these poses that bvkit compiles once, if any; [`PoseSource::named`]
+    /// returns them where it is not [`Route::Generic`] (and their class is 3D).
+    const ROUTE: Route = Route::Generic;
     #[doc(hidden)]
-    /// The poses by name, for the AoS runs, where they are AoS or shared transforms of a 3D
-    /// class.
-    fn aos(&self) -> Option<Named3<'_>> {
+    /// The poses by name.
+    fn named(&self) -> Option<Named3<'_>> {
         None
     }
     #[doc(hidden)]
@@ -164,10 +165,14 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
     fn trim(self, len: usize) -> X::Trimmed {
         TransformSource::trim(self, len)
     }
-    const AOS: bool = X::MAPS;
+    const ROUTE: Route = X::ROUTE;
     #[inline(always)]
-    fn aos(&self) -> Option<Named3<'_>> {
-        X::Class::named(self.maps()?)
+    fn named(&self) -> Option<Named3<'_>> {
+        match X::ROUTE {
+            Route::Aos => X::Class::named(self.maps()?),
+            Route::Blocks => Some(Named3::Rigid3x8(self.rigid3x8s()?)),
+            Route::Generic => None,
+        }
     }
 }
 
@@ -234,13 +239,12 @@ pub(crate) struct Engine<'a, const N: usize, B, P, S> {
 }
 
 impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
-    /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): AoS 3D boxes with AoS
-    /// or shared poses ([`Self::AOS`]) in code compiled once in bvkit, which runs the AoS
-    /// loop or, on the scalar backend, the lane loop; every other layout in the lane loop,
-    /// compiled here.
+    /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): the layouts of a
+    /// [`Route`] in code compiled once in bvkit (the AoS loop, or the lane loop), every
+    /// other layout in the lane loop, compiled here.
     #[inline(always)]
     pub fn run(self, backend: Backend, fused: bool) {
-        if !Self::AOS {
+        if Self::GENERIC {
             return self.run_lanes(backend, fused);
         }
         let Engine {
@@ -252,16 +256,17 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
             rounding,
             ..
         } = self;
-        let (Some(local), Some(poses)) = (local.aabb3s(), poses.aos()) else {
-            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
+        let (Some(local), Some(poses)) = (local.named(), poses.named()) else {
+            unreachable!("the layouts of a route always name themselves (a test checks them)");
         };
-        sink.run_aos(AosCall {
+        sink.run_named(NamedCall {
             local,
             poses,
             active,
             method,
             rounding,
             backend,
+            fused,
         });
     }
 
@@ -309,9 +314,13 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
         }
     }
 
-    /// True for AoS 3D boxes in and out with AoS or shared poses, which the lane loop runs
-    /// only on the scalar backend ([`AosCall::run`]).
-    pub(crate) const AOS: bool = B::AABB3S && P::AOS && S::AABB3S;
+    /// The route of this run: the one its boxes, poses and output all name.
+    pub(crate) const ROUTE: Route = Route::of(B::ROUTE, P::ROUTE, S::ROUTE);
+    /// No route: the lane loop, compiled here.
+    pub(crate) const GENERIC: bool = matches!(Self::ROUTE, Route::Generic);
+    /// AoS 3D boxes in and out with AoS or shared poses, which the lane loop runs only on
+    /// the scalar backend ([`AosCall::run`]).
+    pub(crate) const AOS: bool = matches!(Self::ROUTE, Route::Aos);
 
     /// [`simd::dispatch`], or straight to the scalar reference's lanes where [`Self::AOS`]:
     /// the one backend those layouts take the lane loop on. These runs are compiled once in

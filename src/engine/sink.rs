@@ -3,12 +3,12 @@
 //! records their objects (the broadphase update). The lane loop takes any [`Sink`]; the AoS
 //! loop takes the two as one [`AosSink`].
 
-use super::{AosCall, CHUNK, Extended, PoseSource};
+use super::{BlockSink, CHUNK, Extended, NamedCall, PoseSource};
 use crate::aabb::Aabb3;
 use crate::fat::{Margin, Moved};
 use crate::kernel::gather;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource};
+use crate::layout::{BoxSink, BoxSource, Boxes3Mut, Route};
 use crate::simd::{self, BoxGroup, LaneArray};
 
 /// Where the lane loop's tight boxes go.
@@ -35,12 +35,12 @@ pub(crate) trait Sink<const N: usize> {
     /// True when the sink takes every object ([`Active::All`]), as a batch transform's
     /// does: its runs then compile only that walk (a third of the loops otherwise).
     const EVERY: bool = false;
-    /// True when the sink writes AoS 3D boxes, and [`Sink::run_aos`] takes them.
-    const AABB3S: bool = false;
-    /// The run `call` into this sink, where it writes AoS 3D boxes ([`Sink::AABB3S`]): the
-    /// sink as an [`AosSink`] handed to [`AosCall::run`], which bvkit compiles once, so
-    /// that a generic call site compiles none of it.
-    fn run_aos(self, call: AosCall<'_>);
+    /// The run of this sink's output that bvkit compiles once, if any.
+    const ROUTE: Route = Route::Generic;
+    /// The run `call` into this sink, on its [`Route`] (not [`Route::Generic`]): the sink
+    /// by name handed to [`NamedCall::aos`] or [`NamedCall::blocks`], which bvkit compiles
+    /// once, so that a generic call site compiles none of it.
+    fn run_named(self, call: NamedCall<'_>);
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
@@ -96,12 +96,14 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
         }
     }
     const EVERY: bool = true;
-    const AABB3S: bool = O::AABB3S;
-    fn run_aos(mut self, call: AosCall<'_>) {
-        let Some(out) = self.out.aabb3s_mut() else {
-            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
-        };
-        call.run(AosSink::Store(out));
+    const ROUTE: Route = O::ROUTE;
+    fn run_named(mut self, call: NamedCall<'_>) {
+        let stream = self.stream;
+        match self.out.named_mut() {
+            Some(Boxes3Mut::Aos(out)) => call.aos(AosSink::Store(out)),
+            Some(Boxes3Mut::Blocks(out)) => call.blocks(BlockSink::Store(Store { out, stream })),
+            None => unreachable!("the layouts of a route always name themselves (tested)"),
+        }
     }
     type Trimmed = Store<O::Trimmed>;
     #[inline(always)]
@@ -155,13 +157,16 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
-    const AABB3S: bool = F::AABB3S;
-    fn run_aos(mut self, call: AosCall<'_>) {
-        let Some(fat) = self.fat.aabb3s_mut() else {
-            unreachable!("AoS 3D layouts always convert (a test checks every layout)");
-        };
+    const ROUTE: Route = F::ROUTE;
+    fn run_named(mut self, call: NamedCall<'_>) {
         let (margin, moved) = (self.margin, self.moved);
-        call.run(AosSink::Fat(Fat { fat, margin, moved }));
+        match self.fat.named_mut() {
+            Some(Boxes3Mut::Aos(fat)) => call.aos(AosSink::Fat(Fat { fat, margin, moved })),
+            Some(Boxes3Mut::Blocks(fat)) => {
+                call.blocks(BlockSink::Fat(Fat { fat, margin, moved }));
+            }
+            None => unreachable!("the layouts of a route always name themselves (tested)"),
+        }
     }
     type Trimmed = Fat<'a, F::Trimmed>;
     #[inline(always)]

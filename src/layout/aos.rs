@@ -6,8 +6,7 @@
 //! width, has no mask at all.
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{Maps, box_lanes, zero_fields};
-use crate::aabb::Aabb3;
+use super::{Boxes3, Boxes3Mut, Maps, Route, box_lanes, zero_fields};
 use crate::aabb::Boxes;
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -43,9 +42,9 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[B] {
         let (lo, hi) = box_lanes::<f32, N>(&self[i].to_fields());
         (lo.0, hi.0)
     }
-    const AABB3S: bool = B::AABB3;
-    fn aabb3s(&self) -> Option<&[Aabb3]> {
-        B::aabb3s(self)
+    const ROUTE: Route = if B::AABB3 { Route::Aos } else { Route::Generic };
+    fn named(&self) -> Option<Boxes3<'_>> {
+        B::aabb3s(self).map(Boxes3::Aos)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -100,9 +99,9 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [B] {
         v[N..2 * N].copy_from_slice(&max);
         self[i] = B::from_fields(&v);
     }
-    const AABB3S: bool = B::AABB3;
-    fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
-        B::aabb3s_mut(self)
+    const ROUTE: Route = if B::AABB3 { Route::Aos } else { Route::Generic };
+    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+        B::aabb3s_mut(self).map(Boxes3Mut::Aos)
     }
     #[cfg(feature = "rayon")]
     type Part<'p>
@@ -127,7 +126,7 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[T] {
     fn get(&self, i: usize) -> T {
         self[i]
     }
-    const MAPS: bool = true;
+    const ROUTE: Route = Route::Aos;
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Each(self))
     }
@@ -160,7 +159,7 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &T {
     fn get(&self, _: usize) -> T {
         **self
     }
-    const MAPS: bool = true;
+    const ROUTE: Route = Route::Aos;
     fn maps(&self) -> Option<Maps<'_, T>> {
         Some(Maps::Shared(self))
     }
@@ -182,9 +181,9 @@ impl<'a, const N: usize, E: Boxes<N>> BoxSource<N> for &'a Vec<E> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         BoxSource::get(&self.as_slice(), i)
     }
-    const AABB3S: bool = E::AABB3;
-    fn aabb3s(&self) -> Option<&[Aabb3]> {
-        E::aabb3s(self.as_slice())
+    const ROUTE: Route = if E::AABB3 { Route::Aos } else { Route::Generic };
+    fn named(&self) -> Option<Boxes3<'_>> {
+        E::aabb3s(self).map(Boxes3::Aos)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -227,9 +226,9 @@ impl<'a, const N: usize, E: Boxes<N>> BoxSink<N> for &'a mut Vec<E> {
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);
     }
-    const AABB3S: bool = E::AABB3;
-    fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
-        E::aabb3s_mut(self.as_mut_slice())
+    const ROUTE: Route = if E::AABB3 { Route::Aos } else { Route::Generic };
+    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+        E::aabb3s_mut(self).map(Boxes3Mut::Aos)
     }
     #[cfg(feature = "rayon")]
     type Part<'p>
@@ -254,7 +253,7 @@ impl<'a, const N: usize, E: Class<N>> TransformSource<N> for &'a Vec<E> {
     fn get(&self, i: usize) -> Self::Class {
         TransformSource::get(&self.as_slice(), i)
     }
-    const MAPS: bool = true;
+    const ROUTE: Route = Route::Aos;
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {
         Some(Maps::Each(self.as_slice()))
     }

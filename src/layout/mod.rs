@@ -21,6 +21,48 @@ pub use soa::{
     Rigid3Soa, Rigid3SoaRef, Soa, SoaMut, SoaRef,
 };
 
+/// Which run of a layout bvkit compiles once, in itself, so that a caller's call site
+/// compiles a call rather than the loops. A run takes the route its boxes, poses and
+/// output all name (`Engine::ROUTE`); any other runs the lane loop where it is called.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    /// None: the lane loop, instantiated at the call site.
+    Generic,
+    /// AoS 3D boxes (`&[Aabb3]`) with AoS or shared poses of a 3D class: the AoS loop.
+    Aos,
+    /// AoSoA blocks of 3D boxes (`&[Aabb3x8]`) with blocks of rigid poses
+    /// (`&[Rigid3x8]`), the layout the README recommends for the update: the lane loop.
+    Blocks,
+}
+
+impl Route {
+    /// The route of a run whose boxes, poses and output name `a`, `b` and `c`.
+    pub const fn of(a: Route, b: Route, c: Route) -> Route {
+        match (a, b, c) {
+            (Route::Aos, Route::Aos, Route::Aos) => Route::Aos,
+            (Route::Blocks, Route::Blocks, Route::Blocks) => Route::Blocks,
+            _ => Route::Generic,
+        }
+    }
+}
+
+/// 3D boxes on a [`Route`], by name.
+#[derive(Clone, Copy)]
+pub enum Boxes3<'a> {
+    /// An AoS slice.
+    Aos(&'a [Aabb3]),
+    /// AoSoA blocks.
+    Blocks(&'a [Aabb3x8]),
+}
+
+/// 3D boxes to write on a [`Route`], by name.
+pub enum Boxes3Mut<'a> {
+    /// An AoS slice.
+    Aos(&'a mut [Aabb3]),
+    /// AoSoA blocks.
+    Blocks(&'a mut [Aabb3x8]),
+}
+
 /// Boxes a batch reads, in some layout: see [`Batch`](crate::Batch) for the list. Sealed:
 /// its items are bvkit's own (how a layout loads lanes and single boxes), and hidden.
 #[allow(clippy::len_without_is_empty)] // hidden machinery, not a collection
@@ -34,12 +76,13 @@ pub trait BoxSource<const N: usize> {
     /// Box `i` as `(min, max)`, for the extended path.
     #[doc(hidden)]
     fn get(&self, i: usize) -> ([f32; N], [f32; N]);
-    /// True when [`BoxSource::aabb3s`] always returns the boxes.
+    /// The run of these boxes that bvkit compiles once, if any; [`BoxSource::named`]
+    /// returns them where it is not [`Route::Generic`].
     #[doc(hidden)]
-    const AABB3S: bool = false;
-    /// The boxes as an AoS slice of [`Aabb3`], when they are one.
+    const ROUTE: Route = Route::Generic;
+    /// The boxes by name.
     #[doc(hidden)]
-    fn aabb3s(&self) -> Option<&[Aabb3]> {
+    fn named(&self) -> Option<Boxes3<'_>> {
         None
     }
     /// Asks for box `i`'s cache lines ahead of a scattered access.
@@ -86,12 +129,13 @@ pub trait BoxSink<const N: usize> {
     /// Writes box `i`.
     #[doc(hidden)]
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
-    /// True when [`BoxSink::aabb3s_mut`] always returns the boxes.
+    /// The run of these boxes that bvkit compiles once, if any; [`BoxSink::named_mut`]
+    /// returns them where it is not [`Route::Generic`].
     #[doc(hidden)]
-    const AABB3S: bool = false;
-    /// The boxes as an AoS slice of [`Aabb3`], when they are one.
+    const ROUTE: Route = Route::Generic;
+    /// The boxes by name.
     #[doc(hidden)]
-    fn aabb3s_mut(&mut self) -> Option<&mut [Aabb3]> {
+    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
         None
     }
     /// The same boxes as a source, for a sink that reads the boxes it may rewrite (the
@@ -141,12 +185,19 @@ pub trait TransformSource<const N: usize> {
     /// Transform `i`, for the extended path.
     #[doc(hidden)]
     fn get(&self, i: usize) -> Self::Class;
-    /// True when [`TransformSource::maps`] always returns the transforms.
+    /// The run of these transforms that bvkit compiles once, if any:
+    /// [`TransformSource::maps`] returns them on [`Route::Aos`] (by name where the class
+    /// is 3D), and [`TransformSource::rigid3x8s`] on [`Route::Blocks`].
     #[doc(hidden)]
-    const MAPS: bool = false;
+    const ROUTE: Route = Route::Generic;
     /// The transforms as an AoS slice or one shared transform, when they are.
     #[doc(hidden)]
     fn maps(&self) -> Option<Maps<'_, Self::Class>> {
+        None
+    }
+    /// The transforms as blocks of rigid poses, when they are.
+    #[doc(hidden)]
+    fn rigid3x8s(&self) -> Option<&[Rigid3x8]> {
         None
     }
     /// Asks for transform `i`'s cache lines ahead of a scattered access.

@@ -97,7 +97,7 @@ pub(crate) mod sealed {
 
     use super::*;
     use crate::extended::ExtendedMap;
-    use crate::fields::{Fields, MAX_FIELDS};
+    use crate::fields::{Block8, Fields, MAX_FIELDS};
     use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
 
@@ -110,9 +110,9 @@ pub(crate) mod sealed {
         Shared(&'a T),
     }
 
-    /// AoS or shared poses of a 3D class, by name: how generic code reaches the code bvkit
-    /// compiles once per class (the AoS runs), so that a caller's crate compiles a call
-    /// rather than the loops.
+    /// AoS or shared poses of a 3D class, or blocks of rigid poses, by name: how generic
+    /// code reaches the runs bvkit compiles once (`layout::Route`), so that a caller's crate
+    /// compiles a call rather than the loops.
     #[derive(Clone, Copy)]
     pub enum Named3<'a> {
         /// [`Translation3`] poses.
@@ -125,6 +125,8 @@ pub(crate) mod sealed {
         Trs3(Maps<'a, Trs3>),
         /// `Affine3A` poses.
         Affine3A(Maps<'a, glam::Affine3A>),
+        /// Blocks of [`Rigid3`] poses (`Rigid3x8`).
+        Rigid3x8(&'a [Block8<Rigid3>]),
     }
 
     /// A transform class in `N` dimensions.
@@ -143,6 +145,17 @@ pub(crate) mod sealed {
             Self: Sized,
         {
             let _ = poses;
+            None
+        }
+        /// True when this is [`Rigid3`], whose blocks [`Class::rigid3x8s`] returns: the
+        /// poses of the blocks' runs that bvkit compiles once (`layout::Route`).
+        const RIGID3: bool = false;
+        /// The blocks as blocks of rigid poses, when they are.
+        fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]>
+        where
+            Self: Sized,
+        {
+            let _ = blocks;
             None
         }
     }

@@ -9,7 +9,7 @@ use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
 use super::{Class, Maps, Named3, Transform3};
 use crate::extended::ExtendedMap;
-use crate::fields::{Fields, MAX_FIELDS, vector_at};
+use crate::fields::{Block8, Fields, MAX_FIELDS, vector_at};
 use crate::kernel::{self, AffineLanes};
 use crate::kernel::{JoinLanes, MapKernel};
 use crate::lane::{Axes, Lane, Vector};
@@ -377,6 +377,10 @@ impl Fields for Trs3 {
 impl Class<3> for Rigid3 {
     fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
         Some(Named3::Rigid3(poses))
+    }
+    const RIGID3: bool = true;
+    fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]> {
+        Some(blocks)
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
     #[inline(always)]

@@ -1,5 +1,10 @@
 //! Plain-data types as fixed lists of `f32` fields: the unit that the AoSoA and SoA layouts
-//! store and that the loaders transpose into lanes.
+//! store and that the loaders transpose into lanes; and the AoSoA block of eight
+//! (`block`), whose type the transform classes name (their blocks of poses).
+
+mod block;
+
+pub use block::Block8;
 
 use crate::lane::Vector;
 

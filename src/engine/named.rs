@@ -1,0 +1,90 @@
+//! The runs bvkit compiles once, in itself ([`Route`]): a generic call site hands its
+//! boxes, poses and output over by name ([`Boxes3`], [`Named3`], the sink's output), and
+//! compiles a call rather than the loops.
+
+use super::{Active, AosCall, AosSink, Engine, Fat, Store};
+use crate::fields::Block8;
+#[cfg(doc)]
+use crate::layout::Route;
+use crate::layout::{Aabb3x8, Boxes3};
+use crate::method::{Method, Rounding};
+use crate::simd::Backend;
+use crate::transform::{Named3, Rigid3};
+
+/// A run on a [`Route`], its lengths and its active set checked, with its boxes and poses
+/// by name: what the engine hands to its sink ([`super::Sink::run_named`]), which adds
+/// itself by name and calls [`NamedCall::aos`] or [`NamedCall::blocks`].
+#[derive(Clone, Copy)]
+pub(crate) struct NamedCall<'a> {
+    /// The local boxes.
+    pub local: Boxes3<'a>,
+    /// The poses.
+    pub poses: Named3<'a>,
+    /// The objects visited.
+    pub active: Active<'a>,
+    /// The method.
+    pub method: Method,
+    /// The rounding.
+    pub rounding: Rounding,
+    /// The backend.
+    pub backend: Backend,
+    /// The lanes may fuse multiply-adds.
+    pub fused: bool,
+}
+
+/// The sinks of [`Route::Blocks`]: the plain sink or the fat sink over AoSoA blocks of
+/// 3D boxes.
+pub(crate) enum BlockSink<'a> {
+    /// Every tight box written.
+    Store(Store<&'a mut [Aabb3x8]>),
+    /// Each tight box compared with its fat box.
+    Fat(Fat<'a, &'a mut [Aabb3x8]>),
+}
+
+impl NamedCall<'_> {
+    /// [`Route::Aos`] into `sink`: the AoS loop with the poses' class, or on the scalar
+    /// backend the lane loop ([`AosCall::run`]). Neither generic nor inlined, so that it
+    /// is compiled once, in bvkit, for the five classes and both sinks.
+    #[inline(never)]
+    pub fn aos(self, sink: AosSink<'_>) {
+        let Boxes3::Aos(local) = self.local else {
+            unreachable!("AoS boxes name themselves so (a test checks every layout)");
+        };
+        let call = AosCall {
+            local,
+            poses: self.poses,
+            active: self.active,
+            method: self.method,
+            rounding: self.rounding,
+            backend: self.backend,
+        };
+        call.run(sink);
+    }
+
+    /// [`Route::Blocks`] into `sink`: the lane loop over AoSoA blocks of boxes and of rigid
+    /// poses, on every backend. Compiled once, in bvkit, as [`NamedCall::aos`] is.
+    #[inline(never)]
+    pub fn blocks(self, sink: BlockSink<'_>) {
+        let (Boxes3::Blocks(local), Named3::Rigid3x8(poses)) = (self.local, self.poses) else {
+            unreachable!("blocks of boxes and of rigid poses name themselves so (tested)");
+        };
+        match sink {
+            BlockSink::Store(sink) => self.lanes(local, poses, sink),
+            BlockSink::Fat(sink) => self.lanes(local, poses, sink),
+        }
+    }
+
+    /// The lane loop over blocks into `sink`.
+    fn lanes(self, local: &[Aabb3x8], poses: &[Block8<Rigid3>], sink: impl super::Sink<3>) {
+        let engine = Engine {
+            local,
+            poses,
+            sink,
+            len: local.len() * 8,
+            active: self.active,
+            method: self.method,
+            rounding: self.rounding,
+        };
+        engine.run_lanes(self.backend, self.fused);
+    }
+}
