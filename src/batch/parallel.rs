@@ -99,6 +99,7 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
     fn prefetch(&self, i: usize) {
         self.src.prefetch(self.start + i);
     }
+    const LANES: bool = S::LANES;
     const ROUTE: Route = match S::ROUTE {
         Route::Aos => Route::Aos,
         _ => Route::Generic,

@@ -48,6 +48,7 @@ impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept
         self.current.check_len(len)?;
         self.predicted.check_len(len)
     }
+    const LANES: bool = A::LANES && B::LANES;
     type Trimmed = Swept<A::Trimmed, B::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Self::Trimmed {
@@ -106,6 +107,10 @@ impl<T: LargePose> PoseSource<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         BatchError::check_len("poses", len, self.poses.len())
     }
+    /// Each object's box is computed on its own in `f64` (below), so the run takes lanes
+    /// of one on every backend: the same boxes, and a call site compiles one lane type's
+    /// loops, not four.
+    const LANES: bool = false;
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, len: usize) -> Self {

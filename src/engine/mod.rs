@@ -109,6 +109,11 @@ pub trait PoseSource<const N: usize> {
         let _ = i;
     }
     #[doc(hidden)]
+    /// False when [`PoseSource::tight`] has no lane form (it computes each lane on its
+    /// own): the run then takes lanes of one on every backend, the scalar reference's, and
+    /// compiles no other.
+    const LANES: bool = true;
+    #[doc(hidden)]
     /// The run of these poses that bvkit compiles once, if any; [`PoseSource::named`]
     /// returns them where it is not [`Route::Generic`] (and their class is 3D).
     const ROUTE: Route = Route::Generic;
@@ -322,13 +327,15 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
     /// the scalar backend ([`AosCall::run`]).
     pub(crate) const AOS: bool = matches!(Self::ROUTE, Route::Aos);
 
-    /// [`simd::dispatch`], or straight to the scalar reference's lanes where [`Self::AOS`]:
-    /// the one backend those layouts take the lane loop on. These runs are compiled once in
-    /// bvkit for every class, beside the AoS loop.
+    /// [`simd::dispatch`], or straight to the scalar reference's lanes: where
+    /// [`Self::AOS`], the one backend those layouts take the lane loop on (these runs are
+    /// compiled once in bvkit for every class, beside the AoS loop); and for poses without
+    /// a lane form ([`PoseSource::LANES`]), whose lanes would only be computed one at a
+    /// time (a `LargeWorld` update's call site compiled four lane types' loops for that).
     #[inline(always)]
     fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
-        if Self::AOS {
-            debug_assert_eq!(backend, Backend::Scalar);
+        if Self::AOS || !P::LANES {
+            debug_assert!(!Self::AOS || backend == Backend::Scalar);
             job.run::<f32>();
         } else {
             simd::dispatch(backend, fused, job);
