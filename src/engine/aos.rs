@@ -157,7 +157,7 @@ impl AosRun<'_> {
     /// output pointer on the stack. The plain sink takes every object.
     #[inline(always)]
     pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
-        debug_assert!(matches!(self.sink, AosSink::Fat(_)) || self.active == Active::All);
+        debug_assert!(matches!(self.sink, AosSink::Fat(..)) || self.active == Active::All);
         match self.active {
             Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
             // A list's objects are scattered: they run in no group, compiled once for the
@@ -210,8 +210,8 @@ pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Name
 }
 
 /// A run of the engine over AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), with
-/// the poses by name: what the engine hands to its sink ([`Sink::run_aos`]), so that the
-/// run is compiled once in bvkit for each sink, not at every call site.
+/// the poses by name: what [`super::NamedCall::aos`] runs, once in bvkit for both sinks,
+/// not at every call site.
 #[derive(Clone, Copy)]
 pub(crate) struct AosCall<'a> {
     /// The local boxes.
@@ -267,7 +267,7 @@ impl AosCall<'_> {
     fn sink<P: PoseSource<3>>(self, poses: P, sink: AosSink<'_>) {
         match sink {
             AosSink::Store(out) => self.lanes(poses, Store { out, stream: false }),
-            AosSink::Fat(fat) => self.lanes(poses, fat),
+            AosSink::Fat(fat, _) => self.lanes(poses, fat),
         }
     }
 
@@ -366,16 +366,10 @@ fn chunks<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
     poses: impl PoseList<'p, T>,
     tight: Tight<P, W>,
 ) {
-    let mut scratch = [Aabb3::EMPTY; CHUNK];
     for (c, local) in local.chunks(CHUNK).enumerate() {
         let first = start + c * CHUNK;
-        tight.boxes(
-            local,
-            poses,
-            first,
-            sink.chunk(first, local.len(), &mut scratch),
-        );
-        sink.take::<W, P>(first, &scratch[..local.len()]);
+        tight.boxes(local, poses, first, sink.chunk(first, local.len()));
+        sink.take::<W, P>(first, local.len());
     }
 }
 

@@ -2,15 +2,19 @@
 //! the lane loop and the AoS loop, from a box source and a pose source into a sink.
 //!
 //! A run reads each active object's local box, computes its tight world box from its pose,
-//! and hands it to a sink: [`Store`] writes it (the batch transform), the broadphase's fat
-//! sink compares it with the fat box and records what moved. Two loops do this:
+//! and hands it to a sink: [`Store`] writes it (the batch transform), the fat sink ([`Fat`])
+//! compares it with the fat box and records what moved. Two loops do this:
 //! - [`Engine`], in lanes, for every layout; lanes whose result does not stand are redone
 //!   one at a time on the extended path, and the sink takes those too;
-//! - the AoS loop, for AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), on the
-//!   single-box kernel (glam's `Vec3A`), on every backend but the scalar one. [`Engine::run`]
-//!   hands those layouts, the poses by name ([`Named3`]), to its sink
-//!   ([`Sink::run_aos`]), which runs them in code compiled here once ([`AosCall::run`]):
-//!   the AoS loop, or on the scalar backend the lane loop.
+//! - the AoS loop, for AoS 3D boxes with AoS or shared poses, on the single-box kernel
+//!   (glam's `Vec3A`), on every backend but the scalar one.
+//!
+//! The layouts of a route ([`Engine::ROUTE`]: AoS 3D boxes with AoS or shared poses, and
+//! AoSoA blocks of 3D boxes with blocks of rigid poses) run in code compiled here once:
+//! [`Engine::run`] hands them over by name to the sink ([`Sink::run_named`]), which calls
+//! [`NamedCall::aos`] (the AoS loop, or on the scalar backend the lane loop) or
+//! [`NamedCall::blocks`] (the lane loop). Every other layout runs the lane loop compiled
+//! where it is called.
 
 /// `$body` once per method, with `$m` bound to it as a constant, so that each copy is
 /// specialised to its kernel: the one place the methods are spelled out. With `if $cond`

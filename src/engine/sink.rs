@@ -161,7 +161,10 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     fn run_named(mut self, call: NamedCall<'_>) {
         let (margin, moved) = (self.margin, self.moved);
         match self.fat.named_mut() {
-            Some(Boxes3Mut::Aos(fat)) => call.aos(AosSink::Fat(Fat { fat, margin, moved })),
+            Some(Boxes3Mut::Aos(fat)) => {
+                let mut scratch = [Aabb3::EMPTY; CHUNK];
+                call.aos(AosSink::Fat(Fat { fat, margin, moved }, &mut scratch));
+            }
             Some(Boxes3Mut::Blocks(fat)) => {
                 call.blocks(BlockSink::Fat(Fat { fat, margin, moved }));
             }
@@ -338,33 +341,28 @@ fn keep(fat: &mut Aabb3, tight: Aabb3, margin: Margin) -> bool {
 pub(crate) enum AosSink<'a> {
     /// Every tight box written where it is computed.
     Store(&'a mut [Aabb3]),
-    /// Each tight box compared with its fat box.
-    Fat(Fat<'a, &'a mut [Aabb3]>),
+    /// Each tight box compared with its fat box, a chunk at a time computed into the
+    /// scratch chunk (the caller's, so that a transform's runs fill none).
+    Fat(Fat<'a, &'a mut [Aabb3]>, &'a mut [Aabb3; CHUNK]),
 }
 
 impl AosSink<'_> {
     /// Where the tight boxes of objects `first..first + len` are computed (`len` at most
-    /// [`CHUNK`]): the output itself, or `scratch`.
+    /// [`CHUNK`]): the output itself, or the scratch chunk.
     #[inline(always)]
-    pub fn chunk<'s>(
-        &'s mut self,
-        first: usize,
-        len: usize,
-        scratch: &'s mut [Aabb3; CHUNK],
-    ) -> &'s mut [Aabb3] {
+    pub fn chunk(&mut self, first: usize, len: usize) -> &mut [Aabb3] {
         match self {
             AosSink::Store(out) => &mut out[first..first + len],
-            AosSink::Fat(_) => &mut scratch[..len],
+            AosSink::Fat(_, scratch) => &mut scratch[..len],
         }
     }
 
-    /// The tight boxes `tight` of objects `first..first + tight.len()`, computed where
-    /// [`AosSink::chunk`] said (`scratch` itself, where it said so), compared in groups
-    /// `P` of `W` boxes.
+    /// The tight boxes of objects `first..first + len`, computed where [`AosSink::chunk`]
+    /// said, compared in groups `P` of `W` boxes.
     #[inline(always)]
-    pub fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]) {
-        if let AosSink::Fat(fat) = self {
-            fat.take::<W, P>(first, tight);
+    pub fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, len: usize) {
+        if let AosSink::Fat(fat, scratch) = self {
+            fat.take::<W, P>(first, &scratch[..len]);
         }
     }
 
@@ -373,7 +371,7 @@ impl AosSink<'_> {
     pub fn one(&mut self, i: usize, tight: Aabb3) {
         match self {
             AosSink::Store(out) => out[i] = tight,
-            AosSink::Fat(fat) => fat.one(i, tight),
+            AosSink::Fat(fat, _) => fat.one(i, tight),
         }
     }
 
@@ -381,7 +379,7 @@ impl AosSink<'_> {
     #[inline(always)]
     pub fn prefetch(&self, i: usize) {
         // The plain sink takes every object, in order: only the fat sink is scattered.
-        if let AosSink::Fat(fat) = self {
+        if let AosSink::Fat(fat, _) = self {
             simd::prefetch(&fat.fat[i]);
         }
     }
