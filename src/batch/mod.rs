@@ -214,13 +214,23 @@ mod tests {
         mut out: O,
     ) -> Route {
         let route = Engine::<3, B, X, Store<O>>::ROUTE;
+        // An update's sink takes the same routes.
+        assert_eq!(route, Engine::<3, B, X, crate::engine::Fat<'_, O>>::ROUTE);
+        let predicted = xf.named_predicted();
         let named = (local.named(), xf.named(), out.named_mut());
+        let aos = |p: &Named3| !matches!(p, Named3::Rigid3x8(_));
         match route {
             Route::Generic => {}
-            Route::Aos => assert!(matches!(
-                named,
-                (Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_)))
-                    if !matches!(p, Named3::Rigid3x8(_))
+            Route::Aos => assert!(
+                matches!(
+                    named,
+                    (Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_))) if aos(&p)
+                ) && predicted.is_none()
+            ),
+            Route::Swept => assert!(matches!(
+                (named, predicted),
+                ((Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_))), Some(q))
+                    if aos(&p) && aos(&q)
             )),
             Route::Blocks => assert!(matches!(
                 named,
@@ -265,6 +275,33 @@ mod tests {
         assert_eq!(route(&l8, &r8, &mut out), Route::Generic);
         assert_eq!(route(&local, &r8, &mut out), Route::Generic);
         assert_eq!(route(&local, &rigid, &mut o8), Route::Generic);
+        // Swept pairs of AoS or shared poses, of any 3D classes, with AoS boxes; not of
+        // blocks, nor with blocks of boxes, nor a pair of pairs.
+        fn swept<A, B>(current: A, predicted: B) -> Swept<A, B> {
+            Swept { current, predicted }
+        }
+        let sw = swept(&rigid[..], &rigid[..]);
+        assert_eq!(route(&local, sw, &mut out), Route::Swept);
+        assert_eq!(
+            route(&local, swept(&rigid[..], &rigid[2]), &mut out),
+            Route::Swept
+        );
+        let trs = [Trs3::IDENTITY; 16];
+        assert_eq!(
+            route(&local, swept(&affine, &trs[..]), &mut out),
+            Route::Swept
+        );
+        assert_eq!(
+            route(&local, swept(&r8[..], &r8[..]), &mut out),
+            Route::Generic
+        );
+        assert_eq!(route(&l8, swept(&r8[..], &r8[..]), &mut o8), Route::Generic);
+        assert_eq!(route(&l8, sw, &mut o8), Route::Generic);
+        let pair = Swept {
+            current: sw,
+            predicted: &rigid[..],
+        };
+        assert_eq!(route(&local, pair, &mut out), Route::Generic);
     }
 
     #[test]

@@ -102,10 +102,14 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
     const LANES: bool = S::LANES;
     const ROUTE: Route = match S::ROUTE {
         Route::Aos => Route::Aos,
+        Route::Swept => Route::Swept,
         _ => Route::Generic,
     };
     fn named(&self) -> Option<Named3<'_>> {
         window(self.src.named()?, self.start, self.len)
+    }
+    fn named_predicted(&self) -> Option<Named3<'_>> {
+        window(self.src.named_predicted()?, self.start, self.len)
     }
     type Trimmed = Self;
     #[inline(always)]

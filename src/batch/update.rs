@@ -10,20 +10,24 @@ use crate::engine::{Active, Engine, Fat, PoseSource};
 use crate::error::BatchError;
 use crate::fat::{Margin, Moved};
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource};
+use crate::layout::{BoxSink, BoxSource, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, LaneArray};
+use crate::transform::Named3;
 
 use glam::DVec3;
 
 /// Two poses per object, the current and the predicted one: the tight box is the union of
-/// the boxes at both (the swept box of continuous collision detection), computed in the
-/// same pass.
+/// the boxes at both (the swept box of continuous collision detection). A NaN at either
+/// pose gives the invalid box.
 ///
-/// Where either box needs the extended path (an overflow, an infinite face, a NaN), both
-/// are recomputed there: the union still contains both exact images, though its bits may
-/// differ from the union of two [`Batch::transform`] results. A NaN at either pose gives
-/// an invalid box.
+/// With AoS 3D boxes (`&[Aabb3]`) and AoS or shared poses of any 3D classes at both ends,
+/// the run is compiled once in bvkit, not at the call site: the AoS loop at each pose, a
+/// block of objects at a time, and the union, so each box is exactly the union of two
+/// [`Batch::transform`] results. In any other layout both boxes are computed in one pass
+/// of the lane loop; where either needs the extended path (an overflow, an infinite face,
+/// a NaN), both are recomputed there: the union still contains both exact images, though
+/// its bits may differ from the union of two [`Batch::transform`] results.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Swept<A, B> {
     /// The poses at the start of the step.
@@ -49,6 +53,24 @@ impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept
         self.predicted.check_len(len)
     }
     const LANES: bool = A::LANES && B::LANES;
+    /// Two sets of AoS or shared poses of 3D classes take the AoS loop at each pose, in
+    /// code compiled once in bvkit (with AoS 3D boxes); any other pair the lane loop.
+    const ROUTE: Route = match (A::ROUTE, B::ROUTE) {
+        (Route::Aos, Route::Aos) => Route::Swept,
+        _ => Route::Generic,
+    };
+    fn named(&self) -> Option<Named3<'_>> {
+        match Self::ROUTE {
+            Route::Swept => self.current.named(),
+            _ => None,
+        }
+    }
+    fn named_predicted(&self) -> Option<Named3<'_>> {
+        match Self::ROUTE {
+            Route::Swept => self.predicted.named(),
+            _ => None,
+        }
+    }
     type Trimmed = Swept<A::Trimmed, B::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Self::Trimmed {

@@ -122,8 +122,13 @@ pub trait PoseSource<const N: usize> {
     /// returns them where it is not [`Route::Generic`] (and their class is 3D).
     const ROUTE: Route = Route::Generic;
     #[doc(hidden)]
-    /// The poses by name.
+    /// The poses by name (a [`Swept`](crate::Swept) pair's current ones).
     fn named(&self) -> Option<Named3<'_>> {
+        None
+    }
+    #[doc(hidden)]
+    /// A [`Swept`](crate::Swept) pair's predicted poses by name, on [`Route::Swept`].
+    fn named_predicted(&self) -> Option<Named3<'_>> {
         None
     }
     #[doc(hidden)]
@@ -180,7 +185,7 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
         match X::ROUTE {
             Route::Aos => X::Class::named(self.maps()?),
             Route::Blocks => Some(Named3::Rigid3x8(self.rigid3x8s()?)),
-            Route::Generic => None,
+            Route::Generic | Route::Swept => None,
         }
     }
 }
@@ -265,12 +270,13 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
             rounding,
             ..
         } = self;
-        let (Some(local), Some(poses)) = (local.named(), poses.named()) else {
+        let (Some(local), Some(named)) = (local.named(), poses.named()) else {
             unreachable!("the layouts of a route always name themselves (a test checks them)");
         };
         sink.run_named(NamedCall {
             local,
-            poses,
+            poses: named,
+            predicted: poses.named_predicted(),
             active,
             method,
             rounding,

@@ -18,8 +18,10 @@ use crate::transform::{Named3, Rigid3};
 pub(crate) struct NamedCall<'a> {
     /// The local boxes.
     pub local: Boxes3<'a>,
-    /// The poses.
+    /// The poses (a [`Swept`](crate::Swept) pair's current ones).
     pub poses: Named3<'a>,
+    /// A [`Swept`](crate::Swept) pair's predicted poses ([`Route::Swept`]).
+    pub predicted: Option<Named3<'a>>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -43,8 +45,9 @@ pub(crate) enum BlockSink<'a> {
 
 impl NamedCall<'_> {
     /// [`Route::Aos`] into `sink`: the AoS loop with the poses' class, or on the scalar
-    /// backend the lane loop ([`AosCall::run`]). Neither generic nor inlined, so that it
-    /// is compiled once, in bvkit, for the five classes and both sinks.
+    /// backend the lane loop ([`AosCall::run`]); on [`Route::Swept`], that at each pose
+    /// and the union ([`AosCall::swept`]). Neither generic nor inlined, so that it is
+    /// compiled once, in bvkit, for the five classes and both sinks.
     #[inline(never)]
     pub fn aos(self, sink: AosSink<'_>) {
         let Boxes3::Aos(local) = self.local else {
@@ -58,7 +61,10 @@ impl NamedCall<'_> {
             rounding: self.rounding,
             backend: self.backend,
         };
-        call.run(sink);
+        match self.predicted {
+            None => call.run(sink),
+            Some(predicted) => call.swept(predicted, sink),
+        }
     }
 
     /// [`Route::Blocks`] into `sink`: the lane loop over AoSoA blocks of boxes and of rigid

@@ -33,6 +33,9 @@ pub enum Route {
     /// AoSoA blocks of 3D boxes (`&[Aabb3x8]`) with blocks of rigid poses
     /// (`&[Rigid3x8]`), the layout the README recommends for the update: the lane loop.
     Blocks,
+    /// AoS 3D boxes with a [`Swept`](crate::Swept) pair of AoS or shared poses of 3D
+    /// classes: the AoS loop at each pose, and the union of the two boxes.
+    Swept,
 }
 
 impl Route {
@@ -41,6 +44,7 @@ impl Route {
         match (a, b, c) {
             (Route::Aos, Route::Aos, Route::Aos) => Route::Aos,
             (Route::Blocks, Route::Blocks, Route::Blocks) => Route::Blocks,
+            (Route::Aos, Route::Swept, Route::Aos) => Route::Swept,
             _ => Route::Generic,
         }
     }
