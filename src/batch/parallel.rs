@@ -57,7 +57,7 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
     fn named(&self) -> Option<Boxes3<'_>> {
         match self.src.named()? {
             Boxes3::Aos(boxes) => Some(Boxes3::Aos(boxes.get(self.start..self.start + self.len)?)),
-            Boxes3::Blocks(_) => None,
+            Boxes3::Blocks(_) | Boxes3::Soa(_) => None,
         }
     }
     type Trimmed = Self;

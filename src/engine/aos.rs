@@ -204,7 +204,7 @@ pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Name
         Named3::Similarity3(p) => Named3::Similarity3(part(p, start, len)?),
         Named3::Trs3(p) => Named3::Trs3(part(p, start, len)?),
         Named3::Affine3A(p) => Named3::Affine3A(part(p, start, len)?),
-        Named3::Rigid3x8(_) => return None,
+        Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => return None,
     })
 }
 
@@ -239,7 +239,9 @@ impl AosCall<'_> {
             Named3::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
             Named3::Trs3(maps) => self.class::<Trs3>(maps, sink),
             Named3::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
-            Named3::Rigid3x8(_) => unreachable!("blocks of poses take the blocks' route"),
+            Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => {
+                unreachable!("blocks and columns of poses take their own routes")
+            }
         }
     }
 
@@ -440,7 +442,9 @@ fn tight(poses: Named3<'_>, i: usize, local: &Aabb3, method: Method, rounding: R
         Named3::Similarity3(p) => local.transformed(at(p, i), method, rounding),
         Named3::Trs3(p) => local.transformed(at(p, i), method, rounding),
         Named3::Affine3A(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Rigid3x8(_) => unreachable!("blocks of poses take the blocks' route"),
+        Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => {
+            unreachable!("blocks and columns of poses take their own routes")
+        }
     }
 }
 

@@ -56,7 +56,7 @@ pub use active::Active;
 #[cfg(feature = "rayon")]
 pub(crate) use aos::window;
 pub(crate) use aos::{AosCall, CHUNK};
-pub(crate) use named::{BlockSink, NamedCall};
+pub(crate) use named::{LaneSink, NamedCall};
 pub(crate) use sink::{AosSink, Fat, Sink, Store};
 
 use active::{
@@ -185,6 +185,7 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
         match X::ROUTE {
             Route::Aos => X::Class::named(self.maps()?),
             Route::Blocks => Some(Named3::Rigid3x8(self.rigid3x8s()?)),
+            Route::Soa => Some(Named3::Rigid3Soa(self.rigid3_columns()?.columns)),
             Route::Generic | Route::Swept => None,
         }
     }

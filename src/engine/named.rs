@@ -2,14 +2,13 @@
 //! boxes, poses and output over by name ([`Boxes3`], [`Named3`], the sink's output), and
 //! compiles a call rather than the loops.
 
-use super::{Active, AosCall, AosSink, Engine, Fat, Store};
-use crate::fields::Block8;
+use super::{Active, AosCall, AosSink, Engine, Fat, PoseSource, Store};
 #[cfg(doc)]
 use crate::layout::Route;
-use crate::layout::{Aabb3x8, Boxes3};
+use crate::layout::{Aabb3x8, AabbSoaMut, BoxSource, Boxes3, Rigid3SoaRef};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-use crate::transform::{Named3, Rigid3};
+use crate::transform::Named3;
 
 /// A run on a [`Route`], its lengths and its active set checked, with its boxes and poses
 /// by name: what the engine hands to its sink ([`super::Sink::run_named`]), which adds
@@ -34,13 +33,13 @@ pub(crate) struct NamedCall<'a> {
     pub fused: bool,
 }
 
-/// The sinks of [`Route::Blocks`]: the plain sink or the fat sink over AoSoA blocks of
-/// 3D boxes.
-pub(crate) enum BlockSink<'a> {
+/// The sinks of a route of the lane loop ([`Route::Blocks`]): the plain sink or the fat
+/// sink over output `O`.
+pub(crate) enum LaneSink<'a, O> {
     /// Every tight box written.
-    Store(Store<&'a mut [Aabb3x8]>),
+    Store(Store<O>),
     /// Each tight box compared with its fat box.
-    Fat(Fat<'a, &'a mut [Aabb3x8]>),
+    Fat(Fat<'a, O>),
 }
 
 impl NamedCall<'_> {
@@ -70,23 +69,42 @@ impl NamedCall<'_> {
     /// [`Route::Blocks`] into `sink`: the lane loop over AoSoA blocks of boxes and of rigid
     /// poses, on every backend. Compiled once, in bvkit, as [`NamedCall::aos`] is.
     #[inline(never)]
-    pub fn blocks(self, sink: BlockSink<'_>) {
+    pub fn blocks(self, sink: LaneSink<'_, &mut [Aabb3x8]>) {
         let (Boxes3::Blocks(local), Named3::Rigid3x8(poses)) = (self.local, self.poses) else {
             unreachable!("blocks of boxes and of rigid poses name themselves so (tested)");
         };
         match sink {
-            BlockSink::Store(sink) => self.lanes(local, poses, sink),
-            BlockSink::Fat(sink) => self.lanes(local, poses, sink),
+            LaneSink::Store(sink) => self.lanes(local, poses, local.len() * 8, sink),
+            LaneSink::Fat(sink) => self.lanes(local, poses, local.len() * 8, sink),
         }
     }
 
-    /// The lane loop over blocks into `sink`.
-    fn lanes(self, local: &[Aabb3x8], poses: &[Block8<Rigid3>], sink: impl super::Sink<3>) {
+    /// [`Route::Soa`] into `sink`: the lane loop over columns of boxes and of rigid poses,
+    /// on every backend, in a transform. Compiled once, in bvkit, as [`NamedCall::aos`]
+    /// is. An update's fat sink over columns has no route: its walks would have cost the
+    /// library 75K lines of IR (607,114 against 531,692), past its budget.
+    #[inline(never)]
+    pub fn soa(self, sink: Store<AabbSoaMut<'_>>) {
+        let (Boxes3::Soa(local), Named3::Rigid3Soa(poses)) = (self.local, self.poses) else {
+            unreachable!("columns of boxes and of rigid poses name themselves so (tested)");
+        };
+        let len = local.columns[0].len();
+        self.lanes(local, Rigid3SoaRef::new(poses), len, sink);
+    }
+
+    /// The lane loop over `len` objects into `sink`.
+    fn lanes<B: BoxSource<3>, P: PoseSource<3>>(
+        self,
+        local: B,
+        poses: P,
+        len: usize,
+        sink: impl super::Sink<3>,
+    ) {
         let engine = Engine {
             local,
             poses,
             sink,
-            len: local.len() * 8,
+            len,
             active: self.active,
             method: self.method,
             rounding: self.rounding,

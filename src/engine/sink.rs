@@ -3,7 +3,7 @@
 //! records their objects (the broadphase update). The lane loop takes any [`Sink`]; the AoS
 //! loop takes the two as one [`AosSink`].
 
-use super::{BlockSink, CHUNK, Extended, NamedCall, PoseSource};
+use super::{CHUNK, Extended, LaneSink, NamedCall, PoseSource};
 use crate::aabb::Aabb3;
 use crate::fat::{Margin, Moved};
 use crate::kernel::gather;
@@ -101,7 +101,8 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
         let stream = self.stream;
         match self.out.named_mut() {
             Some(Boxes3Mut::Aos(out)) => call.aos(AosSink::Store(out)),
-            Some(Boxes3Mut::Blocks(out)) => call.blocks(BlockSink::Store(Store { out, stream })),
+            Some(Boxes3Mut::Blocks(out)) => call.blocks(LaneSink::Store(Store { out, stream })),
+            Some(Boxes3Mut::Soa(out)) => call.soa(Store { out, stream }),
             None => unreachable!("the layouts of a route always name themselves (tested)"),
         }
     }
@@ -157,7 +158,11 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
-    const ROUTE: Route = F::ROUTE;
+    /// Columns of boxes have a route in a transform only ([`NamedCall::soa`]).
+    const ROUTE: Route = match F::ROUTE {
+        Route::Soa => Route::Generic,
+        route => route,
+    };
     fn run_named(mut self, call: NamedCall<'_>) {
         let (margin, moved) = (self.margin, self.moved);
         match self.fat.named_mut() {
@@ -166,9 +171,11 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
                 call.aos(AosSink::Fat(Fat { fat, margin, moved }, &mut scratch));
             }
             Some(Boxes3Mut::Blocks(fat)) => {
-                call.blocks(BlockSink::Fat(Fat { fat, margin, moved }));
+                call.blocks(LaneSink::Fat(Fat { fat, margin, moved }));
             }
-            None => unreachable!("the layouts of a route always name themselves (tested)"),
+            Some(Boxes3Mut::Soa(_)) | None => {
+                unreachable!("the layouts of an update's route always name themselves (tested)")
+            }
         }
     }
     type Trimmed = Fat<'a, F::Trimmed>;

@@ -36,6 +36,9 @@ pub enum Route {
     /// AoS 3D boxes with a [`Swept`](crate::Swept) pair of AoS or shared poses of 3D
     /// classes: the AoS loop at each pose, and the union of the two boxes.
     Swept,
+    /// SoA columns of 3D boxes with columns of rigid poses, in a transform (the plain sink):
+    /// the lane loop.
+    Soa,
 }
 
 impl Route {
@@ -45,6 +48,7 @@ impl Route {
             (Route::Aos, Route::Aos, Route::Aos) => Route::Aos,
             (Route::Blocks, Route::Blocks, Route::Blocks) => Route::Blocks,
             (Route::Aos, Route::Swept, Route::Aos) => Route::Swept,
+            (Route::Soa, Route::Soa, Route::Soa) => Route::Soa,
             _ => Route::Generic,
         }
     }
@@ -57,6 +61,8 @@ pub enum Boxes3<'a> {
     Aos(&'a [Aabb3]),
     /// AoSoA blocks.
     Blocks(&'a [Aabb3x8]),
+    /// SoA columns.
+    Soa(AabbSoaRef<'a>),
 }
 
 /// 3D boxes to write on a [`Route`], by name.
@@ -65,6 +71,8 @@ pub enum Boxes3Mut<'a> {
     Aos(&'a mut [Aabb3]),
     /// AoSoA blocks.
     Blocks(&'a mut [Aabb3x8]),
+    /// SoA columns.
+    Soa(AabbSoaMut<'a>),
 }
 
 /// Boxes a batch reads, in some layout: see [`Batch`](crate::Batch) for the list. Sealed:
@@ -191,7 +199,8 @@ pub trait TransformSource<const N: usize> {
     fn get(&self, i: usize) -> Self::Class;
     /// The run of these transforms that bvkit compiles once, if any:
     /// [`TransformSource::maps`] returns them on [`Route::Aos`] (by name where the class
-    /// is 3D), and [`TransformSource::rigid3x8s`] on [`Route::Blocks`].
+    /// is 3D), [`TransformSource::rigid3x8s`] on [`Route::Blocks`] and
+    /// [`TransformSource::rigid3_columns`] on [`Route::Soa`].
     #[doc(hidden)]
     const ROUTE: Route = Route::Generic;
     /// The transforms as an AoS slice or one shared transform, when they are.
@@ -202,6 +211,11 @@ pub trait TransformSource<const N: usize> {
     /// The transforms as blocks of rigid poses, when they are.
     #[doc(hidden)]
     fn rigid3x8s(&self) -> Option<&[Rigid3x8]> {
+        None
+    }
+    /// The transforms as columns of rigid poses, when they are.
+    #[doc(hidden)]
+    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
         None
     }
     /// Asks for transform `i`'s cache lines ahead of a scattered access.

@@ -4,7 +4,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::{BoxSink, BoxSource, TransformSource};
+use super::{BoxSink, BoxSource, Boxes3, Boxes3Mut, Route, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -306,6 +306,10 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for SoaRef<'_, B> {
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
+    const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
+    fn named(&self) -> Option<Boxes3<'_>> {
+        box_columns(B::AABB3, self.columns.as_ref())
+    }
 }
 
 impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
@@ -374,6 +378,10 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
     fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, B>> {
         split_columns(self.columns.as_mut().iter_mut().map(|c| &mut **c), chunk)
     }
+    const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
+    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+        box_columns_mut(B::AABB3, self.columns.as_mut())
+    }
 }
 
 impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
@@ -405,6 +413,14 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
+    const ROUTE: Route = if T::RIGID3 {
+        Route::Soa
+    } else {
+        Route::Generic
+    };
+    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
+        rigid3_columns(T::RIGID3, self.columns.as_ref())
+    }
 }
 
 impl<'a, const N: usize, E: Fields> BoxSource<N> for &'a Soa<E>
@@ -429,6 +445,10 @@ where
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         BoxSource::prefetch(&self.view(), i);
+    }
+    const ROUTE: Route = <SoaRef<'a, E> as BoxSource<N>>::ROUTE;
+    fn named(&self) -> Option<Boxes3<'_>> {
+        box_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
     }
 }
 
@@ -478,6 +498,10 @@ where
             chunk,
         )
     }
+    const ROUTE: Route = <SoaMut<'a, E> as BoxSink<N>>::ROUTE;
+    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+        box_columns_mut(Self::ROUTE == Route::Soa, self.columns.as_mut())
+    }
 }
 
 impl<'a, const N: usize, E: Fields> TransformSource<N> for &'a Soa<E>
@@ -504,4 +528,32 @@ where
     fn prefetch(&self, i: usize) {
         TransformSource::prefetch(&self.view(), i);
     }
+    const ROUTE: Route = <SoaRef<'a, E> as TransformSource<N>>::ROUTE;
+    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
+        rigid3_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
+    }
+}
+
+/// The columns of 3D boxes by name ([`Route::Soa`]), where `aabb3` (the boxes are
+/// [`Aabb3`]s, six columns).
+fn box_columns<C: AsRef<[f32]>>(aabb3: bool, columns: &[C]) -> Option<Boxes3<'_>> {
+    let columns = <&[C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
+    Some(Boxes3::Soa(SoaRef::new(
+        columns.each_ref().map(AsRef::as_ref),
+    )))
+}
+
+/// [`box_columns`] to write.
+fn box_columns_mut<C: AsMut<[f32]>>(aabb3: bool, columns: &mut [C]) -> Option<Boxes3Mut<'_>> {
+    let columns = <&mut [C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
+    Some(Boxes3Mut::Soa(SoaMut::new(
+        columns.each_mut().map(AsMut::as_mut),
+    )))
+}
+
+/// The columns of rigid poses by name ([`Route::Soa`]), where `rigid3` (the poses are
+/// [`Rigid3`]s, seven columns).
+fn rigid3_columns<C: AsRef<[f32]>>(rigid3: bool, columns: &[C]) -> Option<Rigid3SoaRef<'_>> {
+    let columns = <&[C; 7]>::try_from(columns).ok().filter(|_| rigid3)?;
+    Some(SoaRef::new(columns.each_ref().map(AsRef::as_ref)))
 }

@@ -127,6 +127,8 @@ pub(crate) mod sealed {
         Affine3A(Maps<'a, glam::Affine3A>),
         /// Blocks of [`Rigid3`] poses (`Rigid3x8`).
         Rigid3x8(&'a [Block8<Rigid3>]),
+        /// Columns of [`Rigid3`] poses (`Rigid3SoaRef`'s), one per field.
+        Rigid3Soa([&'a [f32]; 7]),
     }
 
     /// A transform class in `N` dimensions.
