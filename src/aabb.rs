@@ -220,11 +220,22 @@ impl Fields for Aabb2 {
     }
 }
 
-/// A box type of `N` dimensions: its fields are `min` then `max`.
+/// A box type of `N` dimensions: its fields are `min` then `max`. The two are [`Aabb3`]
+/// and [`Aabb2`].
 pub(crate) trait Boxes<const N: usize>: Fields {
     /// True when this is [`Aabb3`], whose slices and blocks the hooks below return: the
-    /// boxes of the runs bvkit compiles once (`layout::Route`).
+    /// boxes of the runs bvkit compiles once (`layout::Route`); false for [`Aabb2`].
     const AABB3: bool = false;
+    /// The slice as 2D boxes, when it is one.
+    fn aabb2s(items: &[Self]) -> Option<&[Aabb2]> {
+        let _ = items;
+        None
+    }
+    /// The mutable slice as 2D boxes, when it is one.
+    fn aabb2s_mut(items: &mut [Self]) -> Option<&mut [Aabb2]> {
+        let _ = items;
+        None
+    }
     /// The slice as 3D boxes, when it is one.
     fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
         let _ = items;
@@ -261,4 +272,11 @@ impl Boxes<3> for Aabb3 {
         Some(blocks)
     }
 }
-impl Boxes<2> for Aabb2 {}
+impl Boxes<2> for Aabb2 {
+    fn aabb2s(items: &[Self]) -> Option<&[Aabb2]> {
+        Some(items)
+    }
+    fn aabb2s_mut(items: &mut [Self]) -> Option<&mut [Aabb2]> {
+        Some(items)
+    }
+}

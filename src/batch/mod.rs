@@ -142,12 +142,12 @@ mod tests {
     //! wide code paths (blocks spanning two AoSoA blocks, tails, the extended path).
 
     use super::*;
-    use crate::aabb::Aabb3;
+    use crate::aabb::{Aabb2, Aabb3};
     use crate::engine::{Active, Engine, Store};
-    use crate::layout::{Aabb3x8, Block8, Boxes3, Boxes3Mut, Route, Soa, TransformSource};
+    use crate::layout::{Aabb3x8, Block8, NamedBoxes, NamedBoxesMut, Route, Soa, TransformSource};
     use crate::simd::{F32s, LaneArray};
-    use crate::transform::Named3;
-    use crate::transform::{Rigid3, Similarity3, Translation3, Trs3};
+    use crate::transform::NamedPoses;
+    use crate::transform::{Rigid2, Rigid3, Similarity3, Translation2, Translation3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
 
@@ -208,17 +208,17 @@ mod tests {
     /// The route the layouts' types name: where it is not generic, every source and the
     /// output name themselves for it (so the `unreachable!`s of [`Engine::run`], of the
     /// sinks' `run_named` and of `NamedCall` are never reached), with the kind it says.
-    fn route<B: BoxSource<3>, X: PoseSource<3>, O: BoxSink<3>>(
+    fn route<const N: usize, B: BoxSource<N>, X: PoseSource<N>, O: BoxSink<N>>(
         local: B,
         xf: X,
         mut out: O,
     ) -> Route {
-        let route = Engine::<3, B, X, Store<O>>::ROUTE;
-        // An update's sink takes the same routes, but for the columns'.
-        let fat = Engine::<3, B, X, crate::engine::Fat<'_, O>>::ROUTE;
+        let route = Engine::<N, B, X, Store<O>>::ROUTE;
+        // An update's sink takes the same routes, but for the columns' and the 2D one.
+        let fat = Engine::<N, B, X, crate::engine::Fat<'_, O>>::ROUTE;
         assert_eq!(
             fat,
-            if route == Route::Soa {
+            if matches!(route, Route::Soa | Route::Aos2) {
                 Route::Generic
             } else {
                 route
@@ -226,34 +226,42 @@ mod tests {
         );
         let predicted = xf.named_predicted();
         let named = (local.named(), xf.named(), out.named_mut());
-        let aos = |p: &Named3| !matches!(p, Named3::Rigid3x8(_));
+        let aos = |p: &NamedPoses| !matches!(p, NamedPoses::Rigid3x8(_));
         match route {
             Route::Generic => {}
             Route::Aos => assert!(
                 matches!(
                     named,
-                    (Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_))) if aos(&p)
+                    (Some(NamedBoxes::Aos(_)), Some(p), Some(NamedBoxesMut::Aos(_))) if aos(&p)
                 ) && predicted.is_none()
             ),
             Route::Swept => assert!(matches!(
                 (named, predicted),
-                ((Some(Boxes3::Aos(_)), Some(p), Some(Boxes3Mut::Aos(_))), Some(q))
+                ((Some(NamedBoxes::Aos(_)), Some(p), Some(NamedBoxesMut::Aos(_))), Some(q))
                     if aos(&p) && aos(&q)
             )),
             Route::Blocks => assert!(matches!(
                 named,
                 (
-                    Some(Boxes3::Blocks(_)),
-                    Some(Named3::Rigid3x8(_)),
-                    Some(Boxes3Mut::Blocks(_))
+                    Some(NamedBoxes::Blocks(_)),
+                    Some(NamedPoses::Rigid3x8(_)),
+                    Some(NamedBoxesMut::Blocks(_))
                 )
             )),
             Route::Soa => assert!(matches!(
                 named,
                 (
-                    Some(Boxes3::Soa(_)),
-                    Some(Named3::Rigid3Soa(_)),
-                    Some(Boxes3Mut::Soa(_))
+                    Some(NamedBoxes::Soa(_)),
+                    Some(NamedPoses::Rigid3Soa(_)),
+                    Some(NamedBoxesMut::Soa(_))
+                )
+            )),
+            Route::Aos2 => assert!(matches!(
+                named,
+                (
+                    Some(NamedBoxes::Aos2(_)),
+                    Some(NamedPoses::Rigid2(_)),
+                    Some(NamedBoxesMut::Aos2(_))
                 )
             )),
         }
@@ -330,6 +338,27 @@ mod tests {
         assert_eq!(route(&ls, &rigid[..], &mut os), Route::Generic);
         assert_eq!(route(&local, &rs, &mut out), Route::Generic);
         assert_eq!(route(&ls, &rs, &mut out), Route::Generic);
+        // 2D: AoS boxes with AoS rigid poses; not a shared pose, nor other classes, nor
+        // other layouts, nor a swept pair.
+        let local2 = vec![Aabb2::EMPTY; 16];
+        let mut out2 = vec![Aabb2::NAN; 16];
+        let rigid2 = vec![Rigid2::IDENTITY; 16];
+        assert_eq!(route(&local2[..], &rigid2[..], &mut out2[..]), Route::Aos2);
+        assert_eq!(route(&local2, &rigid2, &mut out2), Route::Aos2);
+        assert_eq!(route(&local2, &rigid2[0], &mut out2), Route::Generic);
+        let affine2 = vec![glam::Affine2::IDENTITY; 16];
+        assert_eq!(route(&local2, &affine2, &mut out2), Route::Generic);
+        let translation2 = vec![Translation2::IDENTITY; 16];
+        assert_eq!(route(&local2, &translation2, &mut out2), Route::Generic);
+        let (l2, r2) = (Block8::pack(&local2), Block8::pack(&rigid2));
+        let mut o2 = vec![Block8::splat(Aabb2::NAN); 2];
+        assert_eq!(route(&l2, &r2, &mut o2), Route::Generic);
+        assert_eq!(route(&local2, &r2, &mut out2), Route::Generic);
+        let (ls2, mut os2) = (Soa::from_slice(&local2), Soa::from_slice(&out2));
+        assert_eq!(route(&ls2, &rigid2, &mut os2), Route::Generic);
+        assert_eq!(route(&ls2, &rigid2, &mut out2), Route::Generic);
+        let sw2 = swept(&rigid2[..], &rigid2[..]);
+        assert_eq!(route(&local2, sw2, &mut out2), Route::Generic);
     }
 
     #[test]

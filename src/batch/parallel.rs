@@ -16,10 +16,10 @@ use crate::engine::{Active, PoseSource, window};
 use crate::error::BatchError;
 use crate::fat::{Margin, Moved};
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, Boxes3, Route};
+use crate::layout::{BoxSink, BoxSource, NamedBoxes, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::LaneArray;
-use crate::transform::Named3;
+use crate::transform::NamedPoses;
 
 /// The fewest boxes a part gets: below this the pool's overhead outweighs the work.
 const MIN_PART: usize = 4096;
@@ -54,10 +54,12 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
         Route::Aos => Route::Aos,
         _ => Route::Generic,
     };
-    fn named(&self) -> Option<Boxes3<'_>> {
+    fn named(&self) -> Option<NamedBoxes<'_>> {
         match self.src.named()? {
-            Boxes3::Aos(boxes) => Some(Boxes3::Aos(boxes.get(self.start..self.start + self.len)?)),
-            Boxes3::Blocks(_) | Boxes3::Soa(_) => None,
+            NamedBoxes::Aos(boxes) => Some(NamedBoxes::Aos(
+                boxes.get(self.start..self.start + self.len)?,
+            )),
+            NamedBoxes::Blocks(_) | NamedBoxes::Soa(_) | NamedBoxes::Aos2(_) => None,
         }
     }
     type Trimmed = Self;
@@ -105,10 +107,10 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
         Route::Swept => Route::Swept,
         _ => Route::Generic,
     };
-    fn named(&self) -> Option<Named3<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         window(self.src.named()?, self.start, self.len)
     }
-    fn named_predicted(&self) -> Option<Named3<'_>> {
+    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
         window(self.src.named_predicted()?, self.start, self.len)
     }
     type Trimmed = Self;

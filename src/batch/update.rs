@@ -13,7 +13,7 @@ use crate::lane::Vector;
 use crate::layout::{BoxSink, BoxSource, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, LaneArray};
-use crate::transform::Named3;
+use crate::transform::NamedPoses;
 
 use glam::DVec3;
 
@@ -59,13 +59,13 @@ impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept
         (Route::Aos, Route::Aos) => Route::Swept,
         _ => Route::Generic,
     };
-    fn named(&self) -> Option<Named3<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         match Self::ROUTE {
             Route::Swept => self.current.named(),
             _ => None,
         }
     }
-    fn named_predicted(&self) -> Option<Named3<'_>> {
+    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
         match Self::ROUTE {
             Route::Swept => self.predicted.named(),
             _ => None,

@@ -18,7 +18,7 @@ use crate::aabb::Aabb3;
 use crate::kernel::{JoinLanes, MapKernel, gather};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
-use crate::transform::{Maps, Named3, Rigid3, Similarity3, Transform3, Translation3, Trs3};
+use crate::transform::{Maps, NamedPoses, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of a span of a mask's walk ([`active::walk`]): a mask word's worth, whole
 /// words that follow each other run several boxes per vector. (Spans of eight cost a
@@ -191,7 +191,7 @@ pub(crate) fn takes_aos(backend: Backend) -> bool {
 
 /// The poses of objects `start..start + len` (a shared pose stays whole), or `None` past
 /// the end: what one part of a parallel batch reads, or one block of a swept run.
-pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Named3<'_>> {
+pub(crate) fn window(poses: NamedPoses<'_>, start: usize, len: usize) -> Option<NamedPoses<'_>> {
     fn part<T>(maps: Maps<'_, T>, start: usize, len: usize) -> Option<Maps<'_, T>> {
         match maps {
             Maps::Each(poses) => Some(Maps::Each(poses.get(start..start.checked_add(len)?)?)),
@@ -199,12 +199,12 @@ pub(crate) fn window(poses: Named3<'_>, start: usize, len: usize) -> Option<Name
         }
     }
     Some(match poses {
-        Named3::Translation3(p) => Named3::Translation3(part(p, start, len)?),
-        Named3::Rigid3(p) => Named3::Rigid3(part(p, start, len)?),
-        Named3::Similarity3(p) => Named3::Similarity3(part(p, start, len)?),
-        Named3::Trs3(p) => Named3::Trs3(part(p, start, len)?),
-        Named3::Affine3A(p) => Named3::Affine3A(part(p, start, len)?),
-        Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => return None,
+        NamedPoses::Translation3(p) => NamedPoses::Translation3(part(p, start, len)?),
+        NamedPoses::Rigid3(p) => NamedPoses::Rigid3(part(p, start, len)?),
+        NamedPoses::Similarity3(p) => NamedPoses::Similarity3(part(p, start, len)?),
+        NamedPoses::Trs3(p) => NamedPoses::Trs3(part(p, start, len)?),
+        NamedPoses::Affine3A(p) => NamedPoses::Affine3A(part(p, start, len)?),
+        NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => return None,
     })
 }
 
@@ -216,7 +216,7 @@ pub(crate) struct AosCall<'a> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// The poses.
-    pub poses: Named3<'a>,
+    pub poses: NamedPoses<'a>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -234,13 +234,13 @@ impl AosCall<'_> {
     #[inline(always)]
     pub fn run(self, sink: AosSink<'_>) {
         match self.poses {
-            Named3::Translation3(maps) => self.class::<Translation3>(maps, sink),
-            Named3::Rigid3(maps) => self.class::<Rigid3>(maps, sink),
-            Named3::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
-            Named3::Trs3(maps) => self.class::<Trs3>(maps, sink),
-            Named3::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
-            Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => {
-                unreachable!("blocks and columns of poses take their own routes")
+            NamedPoses::Translation3(maps) => self.class::<Translation3>(maps, sink),
+            NamedPoses::Rigid3(maps) => self.class::<Rigid3>(maps, sink),
+            NamedPoses::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
+            NamedPoses::Trs3(maps) => self.class::<Trs3>(maps, sink),
+            NamedPoses::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
+            NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => {
+                unreachable!("blocks, columns and 2D poses take their own routes")
             }
         }
     }
@@ -302,7 +302,7 @@ impl AosCall<'_> {
     /// [`Batch::transform`](crate::Batch::transform) results, and a swept run compiles no
     /// loop of its own. An index list, and a block of a mask with few active objects, run
     /// one object at a time ([`tight`]), as the AoS loop runs a list.
-    pub fn swept(self, predicted: Named3<'_>, mut sink: AosSink<'_>) {
+    pub fn swept(self, predicted: NamedPoses<'_>, mut sink: AosSink<'_>) {
         let len = self.local.len();
         let one = |i: usize| {
             let at = |poses| tight(poses, i, &self.local[i], self.method, self.rounding);
@@ -429,7 +429,13 @@ impl GroupJob for Unite<'_, '_> {
 
 /// Object `i`'s tight box from its local box `local`, by the single-box kernel (the bits
 /// of [`Tight::of`], which every backend's AoS run gives).
-fn tight(poses: Named3<'_>, i: usize, local: &Aabb3, method: Method, rounding: Rounding) -> Aabb3 {
+fn tight(
+    poses: NamedPoses<'_>,
+    i: usize,
+    local: &Aabb3,
+    method: Method,
+    rounding: Rounding,
+) -> Aabb3 {
     fn at<T: Transform3>(maps: Maps<'_, T>, i: usize) -> &T {
         match maps {
             Maps::Each(poses) => &poses[i],
@@ -437,13 +443,13 @@ fn tight(poses: Named3<'_>, i: usize, local: &Aabb3, method: Method, rounding: R
         }
     }
     match poses {
-        Named3::Translation3(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Rigid3(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Similarity3(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Trs3(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Affine3A(p) => local.transformed(at(p, i), method, rounding),
-        Named3::Rigid3x8(_) | Named3::Rigid3Soa(_) => {
-            unreachable!("blocks and columns of poses take their own routes")
+        NamedPoses::Translation3(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Rigid3(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Similarity3(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Trs3(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Affine3A(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => {
+            unreachable!("blocks, columns and 2D poses take their own routes")
         }
     }
 }

@@ -71,7 +71,7 @@ use crate::lane::Vector;
 use crate::layout::{BoxSource, Route, TransformSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::{Class, Named3};
+use crate::transform::{Class, NamedPoses};
 
 /// The poses a batch reads, for [`Batch::transform`](crate::Batch::transform) and
 /// [`Batch::update`](crate::Batch::update) alike: transforms
@@ -123,12 +123,12 @@ pub trait PoseSource<const N: usize> {
     const ROUTE: Route = Route::Generic;
     #[doc(hidden)]
     /// The poses by name (a [`Swept`](crate::Swept) pair's current ones).
-    fn named(&self) -> Option<Named3<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         None
     }
     #[doc(hidden)]
     /// A [`Swept`](crate::Swept) pair's predicted poses by name, on [`Route::Swept`].
-    fn named_predicted(&self) -> Option<Named3<'_>> {
+    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
         None
     }
     #[doc(hidden)]
@@ -181,11 +181,11 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
     }
     const ROUTE: Route = X::ROUTE;
     #[inline(always)]
-    fn named(&self) -> Option<Named3<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         match X::ROUTE {
-            Route::Aos => X::Class::named(self.maps()?),
-            Route::Blocks => Some(Named3::Rigid3x8(self.rigid3x8s()?)),
-            Route::Soa => Some(Named3::Rigid3Soa(self.rigid3_columns()?.columns)),
+            Route::Aos | Route::Aos2 => X::Class::named(self.maps()?),
+            Route::Blocks => Some(NamedPoses::Rigid3x8(self.rigid3x8s()?)),
+            Route::Soa => Some(NamedPoses::Rigid3Soa(self.rigid3_columns()?.columns)),
             Route::Generic | Route::Swept => None,
         }
     }

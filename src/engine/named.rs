@@ -1,26 +1,28 @@
 //! The runs bvkit compiles once, in itself ([`Route`]): a generic call site hands its
-//! boxes, poses and output over by name ([`Boxes3`], [`Named3`], the sink's output), and
+//! boxes, poses and output over by name ([`NamedBoxes`], [`NamedPoses`], the sink's output), and
 //! compiles a call rather than the loops.
 
 use super::{Active, AosCall, AosSink, Engine, Fat, PoseSource, Store};
+use crate::aabb::Aabb2;
 #[cfg(doc)]
 use crate::layout::Route;
-use crate::layout::{Aabb3x8, AabbSoaMut, BoxSource, Boxes3, Rigid3SoaRef};
+use crate::layout::{Aabb3x8, AabbSoaMut, BoxSource, NamedBoxes, Rigid3SoaRef};
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-use crate::transform::Named3;
+use crate::transform::NamedPoses;
 
 /// A run on a [`Route`], its lengths and its active set checked, with its boxes and poses
 /// by name: what the engine hands to its sink ([`super::Sink::run_named`]), which adds
-/// itself by name and calls [`NamedCall::aos`] or [`NamedCall::blocks`].
+/// itself by name and calls the route's function ([`NamedCall::aos`], [`NamedCall::blocks`],
+/// [`NamedCall::soa`] or [`NamedCall::aos2`]).
 #[derive(Clone, Copy)]
 pub(crate) struct NamedCall<'a> {
     /// The local boxes.
-    pub local: Boxes3<'a>,
+    pub local: NamedBoxes<'a>,
     /// The poses (a [`Swept`](crate::Swept) pair's current ones).
-    pub poses: Named3<'a>,
+    pub poses: NamedPoses<'a>,
     /// A [`Swept`](crate::Swept) pair's predicted poses ([`Route::Swept`]).
-    pub predicted: Option<Named3<'a>>,
+    pub predicted: Option<NamedPoses<'a>>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -49,7 +51,7 @@ impl NamedCall<'_> {
     /// compiled once, in bvkit, for the five classes and both sinks.
     #[inline(never)]
     pub fn aos(self, sink: AosSink<'_>) {
-        let Boxes3::Aos(local) = self.local else {
+        let NamedBoxes::Aos(local) = self.local else {
             unreachable!("AoS boxes name themselves so (a test checks every layout)");
         };
         let call = AosCall {
@@ -70,7 +72,8 @@ impl NamedCall<'_> {
     /// poses, on every backend. Compiled once, in bvkit, as [`NamedCall::aos`] is.
     #[inline(never)]
     pub fn blocks(self, sink: LaneSink<'_, &mut [Aabb3x8]>) {
-        let (Boxes3::Blocks(local), Named3::Rigid3x8(poses)) = (self.local, self.poses) else {
+        let (NamedBoxes::Blocks(local), NamedPoses::Rigid3x8(poses)) = (self.local, self.poses)
+        else {
             unreachable!("blocks of boxes and of rigid poses name themselves so (tested)");
         };
         match sink {
@@ -85,20 +88,31 @@ impl NamedCall<'_> {
     /// library 75K lines of IR (607,114 against 531,692), past its budget.
     #[inline(never)]
     pub fn soa(self, sink: Store<AabbSoaMut<'_>>) {
-        let (Boxes3::Soa(local), Named3::Rigid3Soa(poses)) = (self.local, self.poses) else {
+        let (NamedBoxes::Soa(local), NamedPoses::Rigid3Soa(poses)) = (self.local, self.poses)
+        else {
             unreachable!("columns of boxes and of rigid poses name themselves so (tested)");
         };
         let len = local.columns[0].len();
         self.lanes(local, Rigid3SoaRef::new(poses), len, sink);
     }
 
+    /// [`Route::Aos2`] into `sink`: the lane loop over AoS 2D boxes and rigid poses, on
+    /// every backend, in a transform. Compiled once, in bvkit, as [`NamedCall::aos`] is.
+    #[inline(never)]
+    pub fn aos2(self, sink: Store<&mut [Aabb2]>) {
+        let (NamedBoxes::Aos2(local), NamedPoses::Rigid2(poses)) = (self.local, self.poses) else {
+            unreachable!("2D boxes and rigid poses name themselves so (tested)");
+        };
+        self.lanes(local, poses, local.len(), sink);
+    }
+
     /// The lane loop over `len` objects into `sink`.
-    fn lanes<B: BoxSource<3>, P: PoseSource<3>>(
+    fn lanes<const N: usize, B: BoxSource<N>, P: PoseSource<N>>(
         self,
         local: B,
         poses: P,
         len: usize,
-        sink: impl super::Sink<3>,
+        sink: impl super::Sink<N>,
     ) {
         let engine = Engine {
             local,

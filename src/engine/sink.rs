@@ -8,7 +8,7 @@ use crate::aabb::Aabb3;
 use crate::fat::{Margin, Moved};
 use crate::kernel::gather;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, Boxes3Mut, Route};
+use crate::layout::{BoxSink, BoxSource, NamedBoxesMut, Route};
 use crate::simd::{self, BoxGroup, LaneArray};
 
 /// Where the lane loop's tight boxes go.
@@ -100,9 +100,10 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
     fn run_named(mut self, call: NamedCall<'_>) {
         let stream = self.stream;
         match self.out.named_mut() {
-            Some(Boxes3Mut::Aos(out)) => call.aos(AosSink::Store(out)),
-            Some(Boxes3Mut::Blocks(out)) => call.blocks(LaneSink::Store(Store { out, stream })),
-            Some(Boxes3Mut::Soa(out)) => call.soa(Store { out, stream }),
+            Some(NamedBoxesMut::Aos(out)) => call.aos(AosSink::Store(out)),
+            Some(NamedBoxesMut::Blocks(out)) => call.blocks(LaneSink::Store(Store { out, stream })),
+            Some(NamedBoxesMut::Soa(out)) => call.soa(Store { out, stream }),
+            Some(NamedBoxesMut::Aos2(out)) => call.aos2(Store { out, stream }),
             None => unreachable!("the layouts of a route always name themselves (tested)"),
         }
     }
@@ -158,22 +159,23 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
     }
-    /// Columns of boxes have a route in a transform only ([`NamedCall::soa`]).
+    /// Columns of boxes and 2D boxes have a route in a transform only ([`NamedCall::soa`],
+    /// [`NamedCall::aos2`]).
     const ROUTE: Route = match F::ROUTE {
-        Route::Soa => Route::Generic,
+        Route::Soa | Route::Aos2 => Route::Generic,
         route => route,
     };
     fn run_named(mut self, call: NamedCall<'_>) {
         let (margin, moved) = (self.margin, self.moved);
         match self.fat.named_mut() {
-            Some(Boxes3Mut::Aos(fat)) => {
+            Some(NamedBoxesMut::Aos(fat)) => {
                 let mut scratch = [Aabb3::EMPTY; CHUNK];
                 call.aos(AosSink::Fat(Fat { fat, margin, moved }, &mut scratch));
             }
-            Some(Boxes3Mut::Blocks(fat)) => {
+            Some(NamedBoxesMut::Blocks(fat)) => {
                 call.blocks(LaneSink::Fat(Fat { fat, margin, moved }));
             }
-            Some(Boxes3Mut::Soa(_)) | None => {
+            Some(NamedBoxesMut::Soa(_) | NamedBoxesMut::Aos2(_)) | None => {
                 unreachable!("the layouts of an update's route always name themselves (tested)")
             }
         }

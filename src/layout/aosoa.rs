@@ -10,7 +10,7 @@ use glam::{Affine2, Affine3A};
 pub use crate::fields::Block8;
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{Boxes3, Boxes3Mut, Route, box_lanes, zero_fields};
+use super::{NamedBoxes, NamedBoxesMut, Route, box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -80,8 +80,8 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[Block8<B>] {
     } else {
         Route::Generic
     };
-    fn named(&self) -> Option<Boxes3<'_>> {
-        B::aabb3x8s(self).map(Boxes3::Blocks)
+    fn named(&self) -> Option<NamedBoxes<'_>> {
+        B::aabb3x8s(self).map(NamedBoxes::Blocks)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -103,8 +103,8 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [Block8<B>] {
     } else {
         Route::Generic
     };
-    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
-        B::aabb3x8s_mut(self).map(Boxes3Mut::Blocks)
+    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
+        B::aabb3x8s_mut(self).map(NamedBoxesMut::Blocks)
     }
     type Read<'r>
         = &'r [Block8<B>]
@@ -247,8 +247,8 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &Vec<Block8<B>> {
     } else {
         Route::Generic
     };
-    fn named(&self) -> Option<Boxes3<'_>> {
-        B::aabb3x8s(self).map(Boxes3::Blocks)
+    fn named(&self) -> Option<NamedBoxes<'_>> {
+        B::aabb3x8s(self).map(NamedBoxes::Blocks)
     }
     type Trimmed = Self;
     #[inline(always)]
@@ -266,8 +266,8 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut Vec<Block8<B>> {
     } else {
         Route::Generic
     };
-    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
-        B::aabb3x8s_mut(self).map(Boxes3Mut::Blocks)
+    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
+        B::aabb3x8s_mut(self).map(NamedBoxesMut::Blocks)
     }
     type Read<'r>
         = &'r [Block8<B>]

@@ -6,7 +6,7 @@ mod aos;
 mod aosoa;
 mod soa;
 
-use crate::aabb::Aabb3;
+use crate::aabb::{Aabb2, Aabb3};
 use crate::error::BatchError;
 use crate::lane::Vector;
 use crate::simd::LaneArray;
@@ -39,6 +39,9 @@ pub enum Route {
     /// SoA columns of 3D boxes with columns of rigid poses, in a transform (the plain sink):
     /// the lane loop.
     Soa,
+    /// AoS 2D boxes (`&[Aabb2]`) with AoS rigid 2D poses (`&[Rigid2]`), in a transform (the
+    /// plain sink): the lane loop.
+    Aos2,
 }
 
 impl Route {
@@ -49,30 +52,35 @@ impl Route {
             (Route::Blocks, Route::Blocks, Route::Blocks) => Route::Blocks,
             (Route::Aos, Route::Swept, Route::Aos) => Route::Swept,
             (Route::Soa, Route::Soa, Route::Soa) => Route::Soa,
+            (Route::Aos2, Route::Aos2, Route::Aos2) => Route::Aos2,
             _ => Route::Generic,
         }
     }
 }
 
-/// 3D boxes on a [`Route`], by name.
+/// Boxes on a [`Route`], by name.
 #[derive(Clone, Copy)]
-pub enum Boxes3<'a> {
-    /// An AoS slice.
+pub enum NamedBoxes<'a> {
+    /// An AoS slice of 3D boxes.
     Aos(&'a [Aabb3]),
     /// AoSoA blocks.
     Blocks(&'a [Aabb3x8]),
     /// SoA columns.
     Soa(AabbSoaRef<'a>),
+    /// An AoS slice of 2D boxes.
+    Aos2(&'a [Aabb2]),
 }
 
-/// 3D boxes to write on a [`Route`], by name.
-pub enum Boxes3Mut<'a> {
-    /// An AoS slice.
+/// Boxes to write on a [`Route`], by name.
+pub enum NamedBoxesMut<'a> {
+    /// An AoS slice of 3D boxes.
     Aos(&'a mut [Aabb3]),
     /// AoSoA blocks.
     Blocks(&'a mut [Aabb3x8]),
     /// SoA columns.
     Soa(AabbSoaMut<'a>),
+    /// An AoS slice of 2D boxes.
+    Aos2(&'a mut [Aabb2]),
 }
 
 /// Boxes a batch reads, in some layout: see [`Batch`](crate::Batch) for the list. Sealed:
@@ -94,7 +102,7 @@ pub trait BoxSource<const N: usize> {
     const ROUTE: Route = Route::Generic;
     /// The boxes by name.
     #[doc(hidden)]
-    fn named(&self) -> Option<Boxes3<'_>> {
+    fn named(&self) -> Option<NamedBoxes<'_>> {
         None
     }
     /// Asks for box `i`'s cache lines ahead of a scattered access.
@@ -147,7 +155,7 @@ pub trait BoxSink<const N: usize> {
     const ROUTE: Route = Route::Generic;
     /// The boxes by name.
     #[doc(hidden)]
-    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
         None
     }
     /// The same boxes as a source, for a sink that reads the boxes it may rewrite (the
@@ -199,7 +207,7 @@ pub trait TransformSource<const N: usize> {
     fn get(&self, i: usize) -> Self::Class;
     /// The run of these transforms that bvkit compiles once, if any:
     /// [`TransformSource::maps`] returns them on [`Route::Aos`] (by name where the class
-    /// is 3D), [`TransformSource::rigid3x8s`] on [`Route::Blocks`] and
+    /// is 3D) and [`Route::Aos2`], [`TransformSource::rigid3x8s`] on [`Route::Blocks`] and
     /// [`TransformSource::rigid3_columns`] on [`Route::Soa`].
     #[doc(hidden)]
     const ROUTE: Route = Route::Generic;

@@ -4,7 +4,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::{BoxSink, BoxSource, Boxes3, Boxes3Mut, Route, TransformSource};
+use super::{BoxSink, BoxSource, NamedBoxes, NamedBoxesMut, Route, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -307,7 +307,7 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for SoaRef<'_, B> {
         prefetch_columns(self.columns.as_ref(), i);
     }
     const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
-    fn named(&self) -> Option<Boxes3<'_>> {
+    fn named(&self) -> Option<NamedBoxes<'_>> {
         box_columns(B::AABB3, self.columns.as_ref())
     }
 }
@@ -379,7 +379,7 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
         split_columns(self.columns.as_mut().iter_mut().map(|c| &mut **c), chunk)
     }
     const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
-    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
         box_columns_mut(B::AABB3, self.columns.as_mut())
     }
 }
@@ -447,7 +447,7 @@ where
         BoxSource::prefetch(&self.view(), i);
     }
     const ROUTE: Route = <SoaRef<'a, E> as BoxSource<N>>::ROUTE;
-    fn named(&self) -> Option<Boxes3<'_>> {
+    fn named(&self) -> Option<NamedBoxes<'_>> {
         box_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
     }
 }
@@ -499,7 +499,7 @@ where
         )
     }
     const ROUTE: Route = <SoaMut<'a, E> as BoxSink<N>>::ROUTE;
-    fn named_mut(&mut self) -> Option<Boxes3Mut<'_>> {
+    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
         box_columns_mut(Self::ROUTE == Route::Soa, self.columns.as_mut())
     }
 }
@@ -536,17 +536,17 @@ where
 
 /// The columns of 3D boxes by name ([`Route::Soa`]), where `aabb3` (the boxes are
 /// [`Aabb3`]s, six columns).
-fn box_columns<C: AsRef<[f32]>>(aabb3: bool, columns: &[C]) -> Option<Boxes3<'_>> {
+fn box_columns<C: AsRef<[f32]>>(aabb3: bool, columns: &[C]) -> Option<NamedBoxes<'_>> {
     let columns = <&[C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
-    Some(Boxes3::Soa(SoaRef::new(
+    Some(NamedBoxes::Soa(SoaRef::new(
         columns.each_ref().map(AsRef::as_ref),
     )))
 }
 
 /// [`box_columns`] to write.
-fn box_columns_mut<C: AsMut<[f32]>>(aabb3: bool, columns: &mut [C]) -> Option<Boxes3Mut<'_>> {
+fn box_columns_mut<C: AsMut<[f32]>>(aabb3: bool, columns: &mut [C]) -> Option<NamedBoxesMut<'_>> {
     let columns = <&mut [C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
-    Some(Boxes3Mut::Soa(SoaMut::new(
+    Some(NamedBoxesMut::Soa(SoaMut::new(
         columns.each_mut().map(AsMut::as_mut),
     )))
 }

@@ -13,7 +13,7 @@ pub use translation::{Translation2, Translation3};
 use crate::kernel::JoinLanes;
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Maps, Named3};
+pub(crate) use sealed::{Class, Maps, NamedPoses};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -110,11 +110,12 @@ pub(crate) mod sealed {
         Shared(&'a T),
     }
 
-    /// AoS or shared poses of a 3D class, or blocks of rigid poses, by name: how generic
+    /// AoS or shared poses of a 3D class, blocks or columns of rigid poses, or a slice of 2D
+    /// rigid poses, by name: how generic
     /// code reaches the runs bvkit compiles once (`layout::Route`), so that a caller's crate
     /// compiles a call rather than the loops.
     #[derive(Clone, Copy)]
-    pub enum Named3<'a> {
+    pub enum NamedPoses<'a> {
         /// [`Translation3`] poses.
         Translation3(Maps<'a, Translation3>),
         /// [`Rigid3`] poses.
@@ -129,6 +130,8 @@ pub(crate) mod sealed {
         Rigid3x8(&'a [Block8<Rigid3>]),
         /// Columns of [`Rigid3`] poses (`Rigid3SoaRef`'s), one per field.
         Rigid3Soa([&'a [f32]; 7]),
+        /// An AoS slice of [`Rigid2`] poses.
+        Rigid2(&'a [Rigid2]),
     }
 
     /// A transform class in `N` dimensions.
@@ -141,8 +144,8 @@ pub(crate) mod sealed {
         fn extended(&self) -> ExtendedMap<N>;
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
-        /// The poses by name: every 3D class, none of the 2D ones.
-        fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>>
+        /// The poses by name: every 3D class, and a slice of [`Rigid2`].
+        fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>>
         where
             Self: Sized,
         {
@@ -152,6 +155,9 @@ pub(crate) mod sealed {
         /// True when this is [`Rigid3`], whose blocks [`Class::rigid3x8s`] returns: the
         /// poses of the blocks' runs that bvkit compiles once (`layout::Route`).
         const RIGID3: bool = false;
+        /// True when this is [`Rigid2`], whose slices [`Class::named`] returns: the poses
+        /// of the 2D runs that bvkit compiles once (`layout::Route::Aos2`).
+        const RIGID2: bool = false;
         /// The blocks as blocks of rigid poses, when they are.
         fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]>
         where

@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
-use super::{Class, Maps, Named3, Transform2, Transform3};
+use super::{Class, Maps, NamedPoses, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
@@ -132,8 +132,8 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
-    fn named(poses: Maps<'_, Self>) -> Option<Named3<'_>> {
-        Some(Named3::Translation3(poses))
+    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
+        Some(NamedPoses::Translation3(poses))
     }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
     #[inline(always)]
