@@ -367,6 +367,17 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
                     }
                 }
             }
+            // The next span is past a gap the hardware prefetcher will not cross: its first
+            // lines are requested now, to arrive while this run computes.
+            if let Some(next) = pending {
+                let reach = next.count.min(RUN_AHEAD).min(end - span.start);
+                let head = next.lanes & (u64::MAX >> (64 - reach));
+                let mut bits = head & (head ^ head << 1 | 0x5555_5555_5555_5555);
+                while bits != 0 {
+                    visit.request(next.start + bits.trailing_zeros() as usize);
+                    bits &= bits - 1;
+                }
+            }
             visit.whole(span.start, end);
         } else {
             visit.part(span, &mut ahead);
@@ -377,10 +388,18 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
 /// How many scattered objects ahead a run requests memory.
 const AHEAD: usize = 16;
 
+/// How far into the next span a run of whole spans requests its active objects before it
+/// runs (those at even offsets, and those that follow an inactive one: about a line each
+/// of 32-byte objects), and no further than the run is long. On a 1M-body update, half of
+/// them asleep in islands of 256, the masked AoS update took 3.2-3.3 ns a body with it,
+/// 3.4-3.7 with 16 and 3.7-4.1 without (AMD EPYC Zen 5).
+const RUN_AHEAD: usize = 64;
+
 /// The scattered objects a run will visit next, whose memory it requests [`AHEAD`]
 /// objects in advance, one object further as each one runs (a burst of requests stalls
 /// the loop once the line fill buffers are full). Runs of whole spans are left to the
-/// hardware prefetcher, and so is every object of [`Active::All`].
+/// hardware prefetcher, but for the head of the span after each run ([`RUN_AHEAD`]), and
+/// so is every object of [`Active::All`].
 ///
 /// The caller requests the objects itself, as [`Self::requests`] yields them, so that its
 /// requests are its own inlined code: handed a closure, the lane loop called it out of
@@ -611,7 +630,16 @@ mod tests {
         walk::<W>(set, len, &mut record);
         assert_eq!(record.run, expected, "{} {set:?}", W::OBJECTS);
         let requested = record.requested.into_inner();
-        assert!(requested.windows(2).all(|w| w[0] < w[1]));
+        // In order, but for the head of the span after a whole run, requested before the
+        // run: each object at most twice, and only active ones.
+        let mut once = requested.clone();
+        once.sort_unstable();
+        once.dedup();
+        assert!(requested.len() <= 2 * once.len());
+        assert!(
+            once.iter()
+                .all(|&i| requested.iter().filter(|&&j| j == i).count() <= 2)
+        );
         assert!(requested.iter().all(|i| expected.contains(i)));
         if W::OBJECTS == 1 {
             assert!(record.whole.is_empty());
