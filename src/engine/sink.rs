@@ -146,6 +146,22 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
         if !(outside + redo).any_nonzero() {
             return;
         }
+        // Boxes left a whole span of active boxes that all stand: the span is stored here,
+        // the boxes that stay with their own bits. Out of line with the rarer cases, it
+        // was most of an update where many bodies move (an AoSoA update of 1M bodies, one
+        // in ten leaving: 4.8 against 3.7 ns a body, AMD EPYC Zen 5).
+        if count == L::WIDTH && lanes == u64::MAX >> (64 - L::WIDTH) && !redo.any_nonzero() {
+            let (grown_min, grown_max) = self.margin.grow(tight[0], tight[1]);
+            let keep = -outside;
+            let (mut min, mut max) = (fat_min, fat_max);
+            for a in 0..N {
+                min.0[a] = keep.select_nonneg(fat_min.0[a], grown_min.0[a]);
+                max.0[a] = keep.select_nonneg(fat_max.0[a], grown_max.0[a]);
+            }
+            self.fat.store(i, count, min, max);
+            self.moved.record(i, u64::from(outside.nonzero_mask()));
+            return;
+        }
         self.rewrite(
             i,
             count,
@@ -193,10 +209,13 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
 }
 
 impl<F> Fat<'_, F> {
-    /// The rest of a span where a box left its fat box or did not stand: the fat boxes
-    /// rewritten and the objects recorded. Out of line: inlined, its code (though rarely
-    /// run) made LLVM spill the hot path, which then ran three times slower. It uses no
-    /// multiply-add, so it needs none of the dispatcher's target features, and it takes
+    /// The rest of a span where a box left its fat box or did not stand, but for a whole
+    /// span that stands (stored inline, [`Sink::span`]): the fat boxes rewritten and the
+    /// objects recorded. Out of line: inlined, its code (though rarely run) made LLVM spill
+    /// the hot path, which then ran three times slower. (An inline store of the whole
+    /// spans ran four times slower too, until `Margin::grow`'s closure, which was called
+    /// out of line without the dispatcher's target features, became a function.) It uses
+    /// no multiply-add, so it needs none of the dispatcher's target features, and it takes
     /// the portable lanes ([`LaneArray::Portable`]), which code compiled without them can
     /// hold.
     #[inline(never)]

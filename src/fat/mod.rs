@@ -71,9 +71,17 @@ impl Margin {
         let half = max * splat(0.5) - min * splat(0.5);
         let g = (half * splat(self.relative)).max(splat(self.absolute));
         let (x, y) = (min - g, max + g);
-        let step = |v: Vector<L, N>| (v.abs() * splat(pow2(-22) as f32)).min(splat(f32::MAX));
         (x - step(x), y + step(y))
     }
+}
+
+/// The outward step of [`Margin::grow`] at faces `v`: `min(|v|·2^-22, MAX)`. A function,
+/// not a closure: a closure is not inlined into the dispatcher's target features, and was
+/// called out of line, its lane operations with it.
+#[inline(always)]
+fn step<L: Lane, const N: usize>(v: Vector<L, N>) -> Vector<L, N> {
+    let splat = Vector::<L, N>::splat;
+    (v.abs() * splat(pow2(-22) as f32)).min(splat(f32::MAX))
 }
 
 /// Lane value 0 where the tight boxes `[min, max]` lie inside the fat boxes, nonzero
