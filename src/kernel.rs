@@ -20,22 +20,11 @@ pub trait MapKernel<V> {
     fn transform(&self, lo: V, hi: V, method: Method, outward: bool) -> (V, V);
 }
 
-/// A map on `Vec3A` lanes (one box) that `W` of can share wider lanes `P`, each in its own
-/// 128-bit part: the AoS loop's several boxes per instruction.
-pub trait JoinLanes: MapKernel<Vec3A> + Copy {
-    /// The same map in lanes `P`.
-    type In<P: Axes>: MapKernel<P>;
-    /// The maps side by side: every field `join` of the maps' own.
-    fn join<P: Axes, const W: usize>(
-        maps: &[Self; W],
-        join: impl Fn([Vec3A; W]) -> P,
-    ) -> Self::In<P>;
-}
-
-impl JoinLanes for AffineLanes<Vec3A, 3> {
-    type In<P: Axes> = AffineLanes<P, 3>;
+impl AffineLanes<Vec3A, 3> {
+    /// `W` maps side by side, every field `join` of the maps' own: the affine class's
+    /// [`Transform3::join`](crate::Transform3).
     #[inline(always)]
-    fn join<P: Axes, const W: usize>(
+    pub(crate) fn join<P: Axes, const W: usize>(
         maps: &[Self; W],
         join: impl Fn([Vec3A; W]) -> P,
     ) -> AffineLanes<P, 3> {
@@ -59,7 +48,7 @@ pub(crate) fn gather<const W: usize, X: Copy>(mut f: impl FnMut(usize) -> X) -> 
 }
 
 /// The three columns of `W` maps side by side, `join` of the maps' own each: the columns
-/// of every [`JoinLanes`] map.
+/// of every affine and quaternion map's `join`.
 #[inline(always)]
 pub(crate) fn join_cols<M, P, const W: usize>(
     maps: &[M; W],

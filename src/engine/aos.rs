@@ -15,7 +15,7 @@ use glam::Vec3A;
 use super::active::{self, List, Lookahead, Mask, Span, SpanWidth, Subset, Upcoming, Visit, Width};
 use super::{Active, AosSink, Engine, PoseSource, Sink, Store};
 use crate::aabb::Aabb3;
-use crate::kernel::{JoinLanes, MapKernel, gather};
+use crate::kernel::{MapKernel, gather};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
 use crate::transform::{Maps, NamedPoses, Rigid3, Similarity3, Transform3, Translation3, Trs3};
@@ -72,7 +72,7 @@ impl<P: BoxGroup<W>, const W: usize> Tight<P, W> {
             let groups = local.chunks_exact(W).zip(out.chunks_exact_mut(W));
             for ((l, o), group) in groups.zip(poses.groups::<W>(first)) {
                 let maps = gather(|k| group[k].simd());
-                let map = <T::Simd as JoinLanes>::join(&maps, P::join);
+                let map = T::join(&maps, P::join);
                 let lo = P::join(gather(|k| l[k].min));
                 let hi = P::join(gather(|k| l[k].max));
                 let (min, max) = map.transform(lo, hi, self.method, outward);

@@ -6,7 +6,7 @@ use super::{Class, Maps, NamedPoses, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::AffineLanes;
-use crate::lane::{Lane, Vector};
+use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
 
 /// Fields `[m00, m10, m20, m01, …, m22, t0, t1, t2]`: the columns, then the translation.
@@ -59,9 +59,16 @@ impl Class<3> for Affine3A {
 }
 
 impl Transform3 for Affine3A {
-    type Simd = AffineLanes<Vec3A, 3>;
+    type Simd<P: Axes> = AffineLanes<P, 3>;
     #[inline(always)]
-    fn simd(&self) -> Self::Simd {
+    fn join<P: Axes, const W: usize>(
+        maps: &[AffineLanes<Vec3A, 3>; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> AffineLanes<P, 3> {
+        AffineLanes::join(maps, join)
+    }
+    #[inline(always)]
+    fn simd(&self) -> AffineLanes<Vec3A, 3> {
         let m = &self.matrix3;
         AffineLanes {
             cols: [m.x_axis, m.y_axis, m.z_axis],

@@ -10,7 +10,8 @@ pub use quat::{Rigid3, Similarity3, Trs3};
 pub use rigid2::Rigid2;
 pub use translation::{Translation2, Translation3};
 
-use crate::kernel::JoinLanes;
+use crate::kernel::MapKernel;
+use crate::lane::Axes;
 use crate::method::Method;
 
 pub(crate) use sealed::{Class, Maps, NamedPoses};
@@ -73,13 +74,21 @@ pub trait Transform3: Class<3> {
         <Self as Class<3>>::order(method)
     }
 
-    /// The class on glam's SIMD `Vec3A`, whose lanes are the axes of one box (sealed
-    /// machinery, as [`Class`]'s).
+    /// The class on lanes `P` whose 128-bit parts hold one pose each, their lanes the
+    /// axes of one box: on glam's SIMD `Vec3A`, one pose (sealed machinery, as
+    /// [`Class`]'s).
     #[doc(hidden)]
-    type Simd: JoinLanes;
-    /// The pose as `Vec3A` lanes.
+    type Simd<P: Axes>: MapKernel<P> + Copy;
+    /// The pose on `Vec3A` lanes.
     #[doc(hidden)]
-    fn simd(&self) -> Self::Simd;
+    fn simd(&self) -> Self::Simd<glam::Vec3A>;
+    /// `W` poses side by side in lanes `P`, one per 128-bit part: every field `join` of
+    /// the poses' own (the AoS loop's several boxes per instruction).
+    #[doc(hidden)]
+    fn join<P: Axes, const W: usize>(
+        poses: &[Self::Simd<glam::Vec3A>; W],
+        join: impl Fn([glam::Vec3A; W]) -> P,
+    ) -> Self::Simd<P>;
 }
 
 /// A 2D transform class: [`Translation2`], [`Rigid2`] and `glam::Affine2`.

@@ -10,8 +10,8 @@ use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 use super::{Class, Maps, NamedPoses, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Block8, Fields, MAX_FIELDS, vector_at};
+use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
-use crate::kernel::{JoinLanes, MapKernel};
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
 
@@ -289,8 +289,9 @@ impl<V: Axes, const SCALED: bool> MapKernel<V> for QuatPose<V, SCALED> {
     }
 }
 
-impl<const SCALED: bool> JoinLanes for QuatPose<Vec3A, SCALED> {
-    type In<P: Axes> = QuatPose<P, SCALED>;
+impl<const SCALED: bool> QuatPose<Vec3A, SCALED> {
+    /// `W` poses side by side, every field `join` of the poses' own: the quaternion
+    /// classes' [`Transform3::join`].
     #[inline(always)]
     fn join<P: Axes, const W: usize>(
         poses: &[Self; W],
@@ -432,23 +433,44 @@ impl Class<3> for Trs3 {
 }
 
 impl Transform3 for Rigid3 {
-    type Simd = QuatPose<Vec3A, false>;
+    type Simd<P: Axes> = QuatPose<P, false>;
     #[inline(always)]
-    fn simd(&self) -> Self::Simd {
+    fn join<P: Axes, const W: usize>(
+        poses: &[QuatPose<Vec3A, false>; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> QuatPose<P, false> {
+        QuatPose::join(poses, join)
+    }
+    #[inline(always)]
+    fn simd(&self) -> QuatPose<Vec3A, false> {
         QuatPose::new(self.rotation, Vec3A::ONE, self.translation)
     }
 }
 impl Transform3 for Similarity3 {
-    type Simd = QuatPose<Vec3A, true>;
+    type Simd<P: Axes> = QuatPose<P, true>;
     #[inline(always)]
-    fn simd(&self) -> Self::Simd {
+    fn join<P: Axes, const W: usize>(
+        poses: &[QuatPose<Vec3A, true>; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> QuatPose<P, true> {
+        QuatPose::join(poses, join)
+    }
+    #[inline(always)]
+    fn simd(&self) -> QuatPose<Vec3A, true> {
         QuatPose::new(self.rotation, Vec3A::splat(self.scale), self.translation)
     }
 }
 impl Transform3 for Trs3 {
-    type Simd = QuatPose<Vec3A, true>;
+    type Simd<P: Axes> = QuatPose<P, true>;
     #[inline(always)]
-    fn simd(&self) -> Self::Simd {
+    fn join<P: Axes, const W: usize>(
+        poses: &[QuatPose<Vec3A, true>; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> QuatPose<P, true> {
+        QuatPose::join(poses, join)
+    }
+    #[inline(always)]
+    fn simd(&self) -> QuatPose<Vec3A, true> {
         QuatPose::new(self.rotation, self.scale, self.translation)
     }
 }

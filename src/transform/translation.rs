@@ -6,7 +6,7 @@ use super::{Class, Maps, NamedPoses, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
-use crate::kernel::{JoinLanes, MapKernel};
+use crate::kernel::MapKernel;
 use crate::lane::{Axes, Lane, Vector};
 use crate::method::Method;
 
@@ -89,19 +89,6 @@ pub struct TranslationLanes<V> {
     pub t: V,
 }
 
-impl JoinLanes for TranslationLanes<Vec3A> {
-    type In<P: Axes> = TranslationLanes<P>;
-    #[inline(always)]
-    fn join<P: Axes, const W: usize>(
-        maps: &[Self; W],
-        join: impl Fn([Vec3A; W]) -> P,
-    ) -> TranslationLanes<P> {
-        TranslationLanes {
-            t: join(kernel::gather(|k| maps[k].t)),
-        }
-    }
-}
-
 impl<V: Lane> MapKernel<V> for TranslationLanes<V> {
     /// Every method is the same map here: `[lo + t, hi + t]`.
     #[inline(always)]
@@ -150,9 +137,18 @@ impl Class<3> for Translation3 {
 }
 
 impl Transform3 for Translation3 {
-    type Simd = TranslationLanes<Vec3A>;
+    type Simd<P: Axes> = TranslationLanes<P>;
     #[inline(always)]
-    fn simd(&self) -> Self::Simd {
+    fn join<P: Axes, const W: usize>(
+        maps: &[TranslationLanes<Vec3A>; W],
+        join: impl Fn([Vec3A; W]) -> P,
+    ) -> TranslationLanes<P> {
+        TranslationLanes {
+            t: join(kernel::gather(|k| maps[k].t)),
+        }
+    }
+    #[inline(always)]
+    fn simd(&self) -> TranslationLanes<Vec3A> {
         TranslationLanes { t: self.0 }
     }
 }
