@@ -15,7 +15,7 @@
 //! - a face beyond the `f32` range: `±inf` for Nearest, the outermost finite or infinite
 //!   value that still contains the exact face for Outward; never NaN.
 
-use glam::Quat;
+use glam::{DMat3, DVec3, Quat};
 
 use crate::method::Rounding;
 use crate::num::{pow2, round_down, round_up, two_sum};
@@ -51,6 +51,24 @@ impl<const N: usize> ExtendedMap<N> {
 }
 
 impl ExtendedMap<3> {
+    /// `M` as a glam matrix (each entry within `col_error` of its column's).
+    #[inline]
+    pub fn matrix(&self) -> DMat3 {
+        DMat3::from_cols_array_2d(&self.cols)
+    }
+
+    /// `t` as a glam vector.
+    #[inline]
+    pub fn translation(&self) -> DVec3 {
+        DVec3::from_array(self.t.map(f64::from))
+    }
+
+    /// `M p + t` in `f64`: each coordinate rounds at most 4 times (a product, three sums).
+    #[inline]
+    pub fn apply(&self, p: DVec3) -> DVec3 {
+        self.matrix() * p + self.translation()
+    }
+
     /// `R(q)·diag(s)`, `t`, from the exact formula of [`crate::kernel::rotation`].
     ///
     /// Every product of two `f32` is exact in `f64`, so each off-diagonal entry

@@ -42,47 +42,31 @@ const MAX_KAPPA: f64 = (1u64 << 40) as f64;
 /// The whole space: the bound of a volume with an infinite field or singular axes.
 const EVERYWHERE: Aabb3 = Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
 
-/// A map `x ↦ M x + t` in `f64`: `m` is within `error[k]` of `M` on every entry of column `k`.
-pub(crate) struct Map {
-    m: DMat3,
-    error: DVec3,
-    t: DVec3,
+/// The map of a transform class in `f64` ([`ExtendedMap`]); `None` when a parameter is
+/// NaN or infinite.
+fn map_of<T: Class<3>>(xf: &T) -> Option<ExtendedMap<3>> {
+    let map = xf.extended();
+    (!map.invalid).then_some(map)
 }
 
-impl Map {
-    /// The map of a transform class; `None` when a parameter is NaN or infinite.
-    fn of<T: Class<3>>(xf: &T) -> Option<Self> {
-        let x: ExtendedMap<3> = xf.extended();
-        (!x.invalid).then(|| Self {
-            m: DMat3::from_cols_array_2d(&x.cols),
-            error: DVec3::from_array(x.col_error),
-            t: Vec3A::from_array(x.t).as_dvec3(),
-        })
-    }
+/// The scale of `M p + t` over points with `|p_k| <= reach_k`, the map's error folded in:
+/// `|t| + |M|·reach + 2^50·Σ_k ε_k·reach_k` on every axis.
+fn magnitude(map: &ExtendedMap<3>, reach: DVec3) -> DVec3 {
+    let error = DVec3::from_array(map.col_error).dot(reach);
+    map.translation().abs() + map.matrix().abs() * reach + DVec3::splat(ABSOLUTE * error)
+}
 
-    /// `M p + t`: each leaf term rounds at most 4 times (a product, three sums).
-    fn apply(&self, p: DVec3) -> DVec3 {
-        self.m * p + self.t
-    }
-
-    /// The scale of `M p + t` over points with `|p_k| <= reach_k`, the map's error folded in:
-    /// `|t| + |M|·reach + 2^50·Σ_k ε_k·reach_k` on every axis.
-    fn magnitude(&self, reach: DVec3) -> DVec3 {
-        self.t.abs() + self.m.abs() * reach + DVec3::splat(ABSOLUTE * self.error.dot(reach))
-    }
-
-    /// `p` through the map rounded to the nearest `f32`, and its exact distance from the
-    /// exact image in the 1-norm, bounded: `Σ_i |v_i − p'_i|` (3 more roundings on the 4 of
-    /// `v`) with the scale of `v` plus `|p'|`.
-    fn moved(&self, p: Vec3A) -> (Vec3A, Bounded) {
-        let v = self.apply(p.as_dvec3());
-        let moved = v.as_vec3a();
-        let shift = Bounded {
-            value: (v - moved.as_dvec3()).abs().element_sum(),
-            scale: (self.magnitude(p.as_dvec3().abs()) + moved.as_dvec3().abs()).element_sum(),
-        };
-        (moved, shift)
-    }
+/// `p` through the map rounded to the nearest `f32`, and its exact distance from the
+/// exact image in the 1-norm, bounded: `Σ_i |v_i − p'_i|` (3 more roundings on the 4 of
+/// `v`) with the scale of `v` plus `|p'|`.
+fn moved(map: &ExtendedMap<3>, p: Vec3A) -> (Vec3A, Bounded) {
+    let v = map.apply(p.as_dvec3());
+    let moved = v.as_vec3a();
+    let shift = Bounded {
+        value: (v - moved.as_dvec3()).abs().element_sum(),
+        scale: (magnitude(map, p.as_dvec3().abs()) + moved.as_dvec3().abs()).element_sum(),
+    };
+    (moved, shift)
 }
 
 /// The lemma's bound on `value`, with `2^-1000` added to its `scale`: an ample cover for
@@ -136,7 +120,7 @@ fn stretch(xf: &Similarity3) -> f64 {
 /// A volume whose image under a map can be bounded: the machinery behind [`BoundingVolume`].
 pub(crate) trait ImageBound {
     /// The bound of the image under `map` (`None`: a NaN or infinite map parameter).
-    fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3;
+    fn aabb_under(&self, map: Option<&ExtendedMap<3>>, rounding: Rounding) -> Aabb3;
 }
 
 /// A bounding volume ([`Obb3`], [`Sphere`], [`Capsule`]) whose world AABB under any 3D
@@ -188,7 +172,7 @@ pub trait BoundingVolume: ImageBound + Sized {
     #[inline]
     #[must_use]
     fn transformed_aabb<T: Transform3>(&self, xf: &T, rounding: Rounding) -> Aabb3 {
-        self.aabb_under(Map::of(xf).as_ref(), rounding)
+        self.aabb_under(map_of(xf).as_ref(), rounding)
     }
 
     /// `out[k]` = the AABB of `volumes[k]` through transform `k`, or through the one shared
@@ -210,7 +194,7 @@ pub trait BoundingVolume: ImageBound + Sized {
         }
         BatchError::check_len("output", expected, out.len())?;
         for (k, (volume, o)) in volumes.iter().zip(out.iter_mut()).enumerate() {
-            *o = volume.aabb_under(Map::of(&xf.get(k)).as_ref(), rounding);
+            *o = volume.aabb_under(map_of(&xf.get(k)).as_ref(), rounding);
         }
         Ok(())
     }
@@ -252,7 +236,7 @@ impl Obb3 {
         // `γ(4)·κ`: the lemma with scale `2·(1 + κ)·|a'_k|·(|c'| + magnitude(reach))`
         // certifies it (module docs).
         let xf = xf.into();
-        let (Some(map), true) = (Map::of(&xf), self.is_finite()) else {
+        let (Some(map), true) = (map_of(&xf), self.is_finite()) else {
             return Self {
                 center: Vec3A::NAN,
                 half_extents: Vec3A::NAN,
@@ -267,7 +251,7 @@ impl Obb3 {
             axes.y_axis.as_vec3a(),
             axes.z_axis.as_vec3a(),
         );
-        let (center, _) = map.moved(self.center);
+        let (center, _) = moved(&map, self.center);
         let half_extents = match dual(self.rotation) {
             _ if self.half_extents.min_element() < 0.0 => self.half_extents,
             None => Vec3A::INFINITY,
@@ -279,9 +263,9 @@ impl Obb3 {
                 );
                 let a2t = rotation.as_dmat3().transpose();
                 let support =
-                    (a2t * (map.m * b)).abs() * h / det + (a2t * (map.apply(c) - c2)).abs();
+                    (a2t * (map.matrix() * b)).abs() * h / det + (a2t * (map.apply(c) - c2)).abs();
                 let reach = c.abs() + b.abs() * h / det;
-                let scale = a2t.abs() * (map.magnitude(reach) + c2.abs()) * (2.0 * (1.0 + kappa));
+                let scale = a2t.abs() * (magnitude(&map, reach) + c2.abs()) * (2.0 * (1.0 + kappa));
                 Vec3A::from_array([0, 1, 2].map(|k| certified(support[k], scale[k]).upper()))
             }
         };
@@ -300,7 +284,7 @@ impl Obb3 {
 /// the map's error adds `Σ_k ε_k·reach_k` with `reach = |c| + |B|·h/|D|`. The lemma's scale
 /// is therefore `2·(1 + κ)·magnitude(reach)` (module docs).
 impl ImageBound for Obb3 {
-    fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
+    fn aabb_under(&self, map: Option<&ExtendedMap<3>>, rounding: Rounding) -> Aabb3 {
         let Some(map) = map.filter(|_| !self.is_nan()) else {
             return Aabb3::NAN;
         };
@@ -312,8 +296,8 @@ impl ImageBound for Obb3 {
         };
         let (c, h) = (self.center.as_dvec3(), self.half_extents.as_dvec3());
         let center = map.apply(c);
-        let extent = (map.m * b).abs() * h / det;
-        let scale = map.magnitude(c.abs() + b.abs() * h / det) * (2.0 * (1.0 + kappa));
+        let extent = (map.matrix() * b).abs() * h / det;
+        let scale = magnitude(map, c.abs() + b.abs() * h / det) * (2.0 * (1.0 + kappa));
         faces(center - extent, center + extent, scale, rounding)
     }
 }
@@ -325,9 +309,9 @@ impl ImageBound for Obb3 {
 /// squares and two sums inside the root halve to `γ(3)/2`, the root one more), times `r`
 /// and `±`: 6 roundings; `‖row_i(M)‖ <= Σ_k |m_ik|` and the norm of `M`'s error row is at
 /// most `Σ_k ε_k`, so `magnitude(|p| + r)` is the lemma's scale.
-fn swept_point(map: &Map, p: Vec3A, radius: f32, rounding: Rounding) -> Aabb3 {
+fn swept_point(map: &ExtendedMap<3>, p: Vec3A, radius: f32, rounding: Rounding) -> Aabb3 {
     let (p, r) = (p.as_dvec3(), f64::from(radius));
-    let rows = map.m.transpose();
+    let rows = map.matrix().transpose();
     let norms = DVec3::new(
         rows.x_axis.length(),
         rows.y_axis.length(),
@@ -337,13 +321,18 @@ fn swept_point(map: &Map, p: Vec3A, radius: f32, rounding: Rounding) -> Aabb3 {
     faces(
         center - norms * r,
         center + norms * r,
-        map.magnitude(p.abs() + r),
+        magnitude(map, p.abs() + r),
         rounding,
     )
 }
 
 /// The bound of a capsule (or a sphere, `a = b`) under `map`, with the contract's bad input.
-fn swept_segment(map: Option<&Map>, [a, b]: [Vec3A; 2], radius: f32, rounding: Rounding) -> Aabb3 {
+fn swept_segment(
+    map: Option<&ExtendedMap<3>>,
+    [a, b]: [Vec3A; 2],
+    radius: f32,
+    rounding: Rounding,
+) -> Aabb3 {
     let nan = a.is_nan() || b.is_nan() || radius.is_nan();
     let Some(map) = map.filter(|_| !nan) else {
         return Aabb3::NAN;
@@ -360,13 +349,13 @@ fn swept_segment(map: Option<&Map>, [a, b]: [Vec3A; 2], radius: f32, rounding: R
 }
 
 impl ImageBound for Sphere {
-    fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
+    fn aabb_under(&self, map: Option<&ExtendedMap<3>>, rounding: Rounding) -> Aabb3 {
         swept_segment(map, [self.center; 2], self.radius, rounding)
     }
 }
 
 impl ImageBound for Capsule {
-    fn aabb_under(&self, map: Option<&Map>, rounding: Rounding) -> Aabb3 {
+    fn aabb_under(&self, map: Option<&ExtendedMap<3>>, rounding: Rounding) -> Aabb3 {
         swept_segment(map, [self.a, self.b], self.radius, rounding)
     }
 }
@@ -395,13 +384,13 @@ impl Sphere {
     pub fn transformed(&self, xf: impl Into<Similarity3>) -> Self {
         let xf = xf.into();
         let finite = self.center.is_finite() && self.radius.is_finite();
-        let Some(map) = Map::of(&xf).filter(|_| finite) else {
+        let Some(map) = map_of(&xf).filter(|_| finite) else {
             return Self {
                 center: Vec3A::NAN,
                 radius: f32::NAN,
             };
         };
-        let (center, shift) = map.moved(self.center);
+        let (center, shift) = moved(&map, self.center);
         let radius = match self.radius {
             r if r < 0.0 => r,
             r => image_radius(&xf, r, &[shift]),
@@ -424,14 +413,14 @@ impl Capsule {
     pub fn transformed(&self, xf: impl Into<Similarity3>) -> Self {
         let xf = xf.into();
         let finite = self.a.is_finite() && self.b.is_finite() && self.radius.is_finite();
-        let Some(map) = Map::of(&xf).filter(|_| finite) else {
+        let Some(map) = map_of(&xf).filter(|_| finite) else {
             return Self {
                 a: Vec3A::NAN,
                 b: Vec3A::NAN,
                 radius: f32::NAN,
             };
         };
-        let ((a, shift_a), (b, shift_b)) = (map.moved(self.a), map.moved(self.b));
+        let ((a, shift_a), (b, shift_b)) = (moved(&map, self.a), moved(&map, self.b));
         let radius = match self.radius {
             r if r < 0.0 => r,
             r => image_radius(&xf, r, &[shift_a, shift_b]),
