@@ -57,81 +57,62 @@ impl<P: BoxGroup<W>, const W: usize> Tight<P, W> {
     /// gathered over each chunk of [`CHUNK`] objects, and a chunk where it fails anywhere is
     /// redone one object at a time with [`Tight::of`]. Each part of a group runs the
     /// operations of the single-box kernel, so every object gets exactly `of`'s bits.
+    ///
+    /// Every walk passes poses of one variant, built where it calls: inlined, the match on
+    /// it folds away, and each kernel compiles one loop per variant.
     #[inline(always)]
-    pub fn boxes<'p, T: Transform3 + 'p>(
+    pub fn boxes<T: Transform3>(
         self,
         local: &[Aabb3],
-        poses: impl PoseList<'p, T>,
+        poses: Maps<'_, T>,
         start: usize,
         out: &mut [Aabb3],
     ) {
-        let outward = self.rounding == Rounding::Outward;
         for (c, (local, out)) in local.chunks(CHUNK).zip(out.chunks_mut(CHUNK)).enumerate() {
             let first = start + c * CHUNK;
-            let mut stands = P::all_set();
-            let groups = local.chunks_exact(W).zip(out.chunks_exact_mut(W));
-            for ((l, o), group) in groups.zip(poses.groups::<W>(first)) {
-                let maps = gather(|k| group[k].simd());
-                let map = T::join(&maps, P::join);
-                let lo = P::join(gather(|k| l[k].min));
-                let hi = P::join(gather(|k| l[k].max));
-                let (min, max) = map.transform(lo, hi, self.method, outward);
-                stands = P::and(stands, P::stands(lo, hi, min, max));
-                for ((o, min), max) in o.iter_mut().zip(min.parts()).zip(max.parts()) {
-                    *o = Aabb3 { min, max };
+            let stands = match poses {
+                Maps::Each(poses) => {
+                    let groups = poses[first..].chunks_exact(W).map(|g| gather(|k| &g[k]));
+                    self.groups(local, groups, out)
                 }
-            }
+                Maps::Shared(pose) => self.groups(local, core::iter::repeat([pose; W]), out),
+            };
             for k in local.len() - local.len() % W..local.len() {
                 out[k] = self.of(&local[k], poses.at(first + k));
             }
             if !P::all_xyz(stands) {
                 core::hint::cold_path();
-                for ((l, o), pose) in local.iter().zip(out.iter_mut()).zip(poses.from(first)) {
-                    *o = self.of(l, pose);
+                for (k, (l, o)) in local.iter().zip(out.iter_mut()).enumerate() {
+                    *o = self.of(l, poses.at(first + k));
                 }
             }
         }
     }
-}
 
-/// The poses of the AoS loop, split once from [`Maps`]: a slice, or one shared pose.
-pub(crate) trait PoseList<'p, T: 'p>: Copy {
-    /// Object `i`'s pose.
-    fn at(self, i: usize) -> &'p T;
-    /// The poses of objects `start..`, in order.
-    fn from(self, start: usize) -> impl Iterator<Item = &'p T>;
-    /// The poses of objects `start..`, `W` at a time.
-    fn groups<const W: usize>(self, start: usize) -> impl Iterator<Item = [&'p T; W]>;
-}
-
-impl<'p, T> PoseList<'p, T> for &'p [T] {
+    /// The whole groups of a chunk, `out[k]` from `local[k]` at the poses `groups` yields
+    /// `W` at a time: the single-box kernel's test, set where every result stands.
     #[inline(always)]
-    fn at(self, i: usize) -> &'p T {
-        &self[i]
-    }
-    #[inline(always)]
-    fn from(self, start: usize) -> impl Iterator<Item = &'p T> {
-        self[start..].iter()
-    }
-    #[inline(always)]
-    fn groups<const W: usize>(self, start: usize) -> impl Iterator<Item = [&'p T; W]> {
-        self[start..].chunks_exact(W).map(|g| gather(|k| &g[k]))
-    }
-}
-
-/// One pose shared by every object.
-impl<'p, T> PoseList<'p, T> for &'p T {
-    #[inline(always)]
-    fn at(self, _: usize) -> &'p T {
-        self
-    }
-    #[inline(always)]
-    fn from(self, _: usize) -> impl Iterator<Item = &'p T> {
-        core::iter::repeat(self)
-    }
-    #[inline(always)]
-    fn groups<const W: usize>(self, _: usize) -> impl Iterator<Item = [&'p T; W]> {
-        core::iter::repeat([self; W])
+    fn groups<'p, T: Transform3 + 'p>(
+        self,
+        local: &[Aabb3],
+        groups: impl Iterator<Item = [&'p T; W]>,
+        out: &mut [Aabb3],
+    ) -> P::Mask {
+        let outward = self.rounding == Rounding::Outward;
+        let mut stands = P::all_set();
+        let boxes = local.chunks_exact(W).zip(out.chunks_exact_mut(W));
+        for ((l, o), group) in boxes.zip(groups) {
+            let maps = gather(|k| group[k].simd());
+            let map = T::join(&maps, P::join);
+            let lo = P::join(gather(|k| l[k].min));
+            let hi = P::join(gather(|k| l[k].max));
+            let (min, max) = map.transform(lo, hi, self.method, outward);
+            stands = P::and(stands, P::stands(lo, hi, min, max));
+            for ((o, min), max) in o.iter_mut().zip(min.parts()).zip(max.parts()) {
+                *o = Aabb3 { min, max };
+            }
+        }
+        stands
     }
 }
 
@@ -436,18 +417,12 @@ fn tight(
     method: Method,
     rounding: Rounding,
 ) -> Aabb3 {
-    fn at<T: Transform3>(maps: Maps<'_, T>, i: usize) -> &T {
-        match maps {
-            Maps::Each(poses) => &poses[i],
-            Maps::Shared(pose) => pose,
-        }
-    }
     match poses {
-        NamedPoses::Translation3(p) => local.transformed(at(p, i), method, rounding),
-        NamedPoses::Rigid3(p) => local.transformed(at(p, i), method, rounding),
-        NamedPoses::Similarity3(p) => local.transformed(at(p, i), method, rounding),
-        NamedPoses::Trs3(p) => local.transformed(at(p, i), method, rounding),
-        NamedPoses::Affine3A(p) => local.transformed(at(p, i), method, rounding),
+        NamedPoses::Translation3(p) => local.transformed(p.at(i), method, rounding),
+        NamedPoses::Rigid3(p) => local.transformed(p.at(i), method, rounding),
+        NamedPoses::Similarity3(p) => local.transformed(p.at(i), method, rounding),
+        NamedPoses::Trs3(p) => local.transformed(p.at(i), method, rounding),
+        NamedPoses::Affine3A(p) => local.transformed(p.at(i), method, rounding),
         NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => {
             unreachable!("blocks, columns and 2D poses take their own routes")
         }
@@ -484,8 +459,8 @@ macro_rules! each_kernel {
             groups: PhantomData,
         };
         match $maps {
-            Maps::Each(poses) => $walk($run, &poses[..len], tight $(, $set)?),
-            Maps::Shared(pose) => $walk($run, pose, tight $(, $set)?),
+            Maps::Each(poses) => $walk($run, Maps::Each(&poses[..len]), tight $(, $set)?),
+            shared @ Maps::Shared(_) => $walk($run, shared, tight $(, $set)?),
         }
     }};
 }
@@ -521,9 +496,9 @@ impl<T: Transform3, A: Subset, Sp: SpanWidth> GroupJob for Scattered<'_, '_, T, 
 
 /// [`Every`] with one method, rounding and pose kind.
 #[inline(always)]
-fn whole<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
+fn whole<T: Transform3, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_>,
-    poses: impl PoseList<'p, T>,
+    poses: Maps<'_, T>,
     tight: Tight<P, W>,
 ) {
     let AosRun {
@@ -535,11 +510,11 @@ fn whole<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
 /// Objects `start..start + local.len()`, every one active, `start` a multiple of [`CHUNK`]:
 /// their tight boxes into the sink a chunk at a time.
 #[inline(always)]
-fn chunks<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
+fn chunks<T: Transform3, const W: usize, P: BoxGroup<W>>(
     sink: &mut AosSink<'_>,
     start: usize,
     local: &[Aabb3],
-    poses: impl PoseList<'p, T>,
+    poses: Maps<'_, T>,
     tight: Tight<P, W>,
 ) {
     for (c, local) in local.chunks(CHUNK).enumerate() {
@@ -553,9 +528,9 @@ fn chunks<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>>(
 /// vector, with the validity test per chunk ([`Tight::boxes`]), and the objects of other
 /// spans one at a time.
 #[inline(always)]
-fn scattered<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>, Sp: SpanWidth>(
+fn scattered<T: Transform3, const W: usize, P: BoxGroup<W>, Sp: SpanWidth>(
     run: AosRun<'_>,
-    poses: impl PoseList<'p, T>,
+    poses: Maps<'_, T>,
     tight: Tight<P, W>,
     (set, _): (impl Subset, PhantomData<Sp>),
 ) {
@@ -565,26 +540,19 @@ fn scattered<'p, T: Transform3 + 'p, const W: usize, P: BoxGroup<W>, Sp: SpanWid
         sink,
         poses,
         tight,
-        class: PhantomData,
     };
     active::walk::<Sp>(set, local.len(), &mut objects);
 }
 
 /// The AoS loop's visit of a scattered active set.
-struct Objects<'a, 'p, Q, T, G> {
+struct Objects<'a, 'p, T, G> {
     local: &'a [Aabb3],
     sink: AosSink<'a>,
-    poses: Q,
+    poses: Maps<'p, T>,
     tight: G,
-    class: PhantomData<fn() -> &'p T>,
 }
 
-impl<'p, T, Q, const W: usize, P> Visit for Objects<'_, 'p, Q, T, Tight<P, W>>
-where
-    T: Transform3 + 'p,
-    Q: PoseList<'p, T>,
-    P: BoxGroup<W>,
-{
+impl<T: Transform3, const W: usize, P: BoxGroup<W>> Visit for Objects<'_, '_, T, Tight<P, W>> {
     #[inline(always)]
     fn whole(&mut self, start: usize, end: usize) {
         let local = &self.local[start..end];

@@ -119,6 +119,17 @@ pub(crate) mod sealed {
         Shared(&'a T),
     }
 
+    impl<'a, T> Maps<'a, T> {
+        /// Box `i`'s transform.
+        #[inline(always)]
+        pub fn at(self, i: usize) -> &'a T {
+            match self {
+                Maps::Each(maps) => &maps[i],
+                Maps::Shared(map) => map,
+            }
+        }
+    }
+
     /// AoS or shared poses of a 3D class, blocks or columns of rigid poses, or a slice of 2D
     /// rigid poses, by name: how generic
     /// code reaches the runs bvkit compiles once (`layout::Route`), so that a caller's crate
