@@ -115,8 +115,8 @@ impl Node {
         Aabb3::new(Vec3A::from_array(lo), Vec3A::from_array(hi))
     }
 
-    /// Bit `k` set when child `k`'s box overlaps the query's (closed boxes): twelve lane
-    /// compares.
+    /// Bit `k` set when child `k`'s box overlaps the query's (closed boxes): six 8-lane
+    /// compares (twelve SSE compares on a baseline x86-64 build).
     #[inline(always)]
     fn overlaps(&self, q: &Query) -> u32 {
         let mut hit = f32x8::splat(0.0).simd_le(f32x8::splat(0.0));

@@ -9,11 +9,13 @@
 //! - the AoS loop, for AoS 3D boxes with AoS or shared poses, on the single-box kernel
 //!   (glam's `Vec3A`), on every backend but the scalar one.
 //!
-//! The layouts of a route ([`Engine::ROUTE`]: AoS 3D boxes with AoS or shared poses, and
-//! AoSoA blocks of 3D boxes with blocks of rigid poses) run in code compiled here once:
-//! [`Engine::run`] hands them over by name to the sink ([`Sink::run_named`]), which calls
-//! [`NamedCall::aos`] (the AoS loop, or on the scalar backend the lane loop) or
-//! [`NamedCall::blocks`] (the lane loop). Every other layout runs the lane loop compiled
+//! The layouts of a route ([`Engine::ROUTE`]: AoS 3D boxes with AoS or shared poses, or a
+//! `Swept` pair of them; AoSoA blocks of 3D boxes with blocks of rigid poses; and, in a
+//! transform, SoA columns of 3D boxes with columns of rigid poses, and AoS 2D boxes with
+//! AoS rigid 2D poses) run in code compiled here once: [`Engine::run`] hands them over by
+//! name to the sink ([`Sink::run_named`]), which calls [`NamedCall::aos`] (the AoS loop, or
+//! on the scalar backend the lane loop), [`NamedCall::blocks`], [`NamedCall::soa`] or
+//! [`NamedCall::aos2`] (the lane loop). Every other layout runs the lane loop compiled
 //! where it is called.
 
 /// `$body` once per method, with `$m` bound to it as a constant, so that each copy is

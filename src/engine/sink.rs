@@ -32,8 +32,9 @@ pub(crate) trait Sink<const N: usize> {
     }
     /// After the last span (a fence after streaming stores).
     fn finish(&mut self) {}
-    /// True when the sink takes every object ([`Active::All`]), as a batch transform's
-    /// does: its runs then compile only that walk (a third of the loops otherwise).
+    /// True when the sink takes every object ([`Active::All`](super::Active::All)), as a
+    /// batch transform's does: its runs then compile only that walk (a third of the loops
+    /// otherwise).
     const EVERY: bool = false;
     /// The run of this sink's output that bvkit compiles once, if any.
     const ROUTE: Route = Route::Generic;

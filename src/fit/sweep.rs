@@ -1,7 +1,8 @@
 //! Sweeps: the linear passes of the fits over every input point, in lanes.
 //!
-//! Each sweep is one pass on the running CPU's best backend ([`Backend::detect`]), run
-//! unfused, so that its result does not depend on the backend: the same bits on every CPU.
+//! Each sweep is one pass on the running CPU's best backend
+//! ([`Backend::detect`](crate::Backend::detect)), run unfused, so that its result does not
+//! depend on the backend: the same bits on every CPU.
 //! A sweep is plain array code over groups of [`WIDTH`] points, transposed into coordinate
 //! columns and compiled inside the backend's dispatch wrapper, so that it vectorises for
 //! its instructions; sums keep [`WIDTH`] partial sums (point `i` goes to sum `i mod WIDTH`),

@@ -148,7 +148,7 @@ fn plane_signs(t: &[DVec3; 3], u: &[DVec3; 3]) -> Option<[i8; 3]> {
     Some(signs)
 }
 
-/// Triangle pairs per batch of the lane filter ([`filter`]).
+/// Triangle pairs per batch of the lane filter ([`filter_batch`]).
 pub(crate) const LANES: usize = 32;
 
 /// Triangles in lanes: coordinate `c` of corner `k` of the triangle in lane `l` at
