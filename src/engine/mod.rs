@@ -80,7 +80,7 @@ use crate::transform::{Class, NamedPoses};
 /// of any class in any layout (AoS slices `&[T]`, AoSoA blocks, SoA columns, or one shared
 /// `&T`), a [`Swept`](crate::Swept) pair of them, or [`LargeWorld`](crate::LargeWorld)
 /// poses. Sealed, as
-/// [`BoxSource`](crate::BoxSource).
+/// [`BoxSource`].
 pub trait PoseSource<const N: usize> {
     #[doc(hidden)]
     /// Refuses a pose count other than `len` (a shared pose has none).

@@ -46,7 +46,7 @@ pub(crate) trait Sink<const N: usize> {
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
-    /// [`BoxSource::trim`](crate::layout::BoxSource::trim)).
+    /// [`BoxSource::trim`]).
     fn trim(self, len: usize) -> Self::Trimmed;
 }
 

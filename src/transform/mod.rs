@@ -44,7 +44,7 @@ pub(crate) use sealed::{Class, Maps, NamedPoses};
 ///
 /// ## Bounds per class
 ///
-/// Every bound has the form of [`Method`](crate::Method): Nearest faces within
+/// Every bound has the form of [`Method`]: Nearest faces within
 /// `γ(n)·S_i + τ·TINY_ERROR`, Outward faces containing the exact face and within twice the
 /// pad `(n + 2)·u·S_i + τ·TINY_PAD`, where `n` is [`Transform3::nearest_order`]
 /// ([`Transform2::nearest_order`]) and the magnitude `S_i` and the factor `τ` are:

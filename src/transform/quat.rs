@@ -21,7 +21,7 @@ use crate::method::Method;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Rigid3 {
-    /// The rotation; used as stored (see [`Transform3`](crate::Transform3)).
+    /// The rotation; used as stored (see [`Transform3`]).
     pub rotation: Quat,
     /// The translation, applied after the rotation.
     pub translation: Vec3A,
