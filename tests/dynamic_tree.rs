@@ -416,6 +416,74 @@ fn most_bodies_leaving_every_frame_end_exactly_their_pairs() {
 }
 
 #[test]
+fn most_bodies_moving_while_some_park_come_back_and_leave_miss_no_pair() {
+    // Half of the proxies or more moving in one write take the one-pass refit of the slots
+    // above them. Meanwhile some movers get a NaN box (parked, which takes them out of the
+    // hierarchy), parked ones come back with a good box (inserted again), bodies are removed
+    // and inserted between frames, and the upkeep rebuilds the tree every few frames:
+    // every report must still be the differences of the brute-force pair sets.
+    const N: usize = 600;
+    let mut r = StdRng::seed_from_u64(81);
+    let mut crowd = Crowd::new(&mut r, N, 10.0);
+    let mut member = vec![true; N];
+    let mut fat = crowd.boxes();
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    tree.set_rebuild_after(3.0);
+    tree.set_rebuild_frames(2);
+    let mut pairs = Pairs::with_ended();
+    tree.update(&[], &fat, &mut pairs).unwrap();
+    let present = |fat: &[Aabb3], member: &[bool]| -> Vec<bool> {
+        (0..N)
+            .map(|i| member[i] && !fat[i].min.x.is_nan())
+            .collect()
+    };
+    let mut before = brute_force(&fat, &present(&fat, &member));
+    let (mut parked, mut unparked, mut refused) = (0, 0, 0);
+    for frame in 0..40 {
+        for _ in 0..4 {
+            let i = r.random_range(0..N);
+            if member[i] {
+                assert!(tree.remove(i as u32));
+            } else {
+                if fat[i].min.x.is_nan() {
+                    fat[i] = crowd.boxes()[i];
+                }
+                tree.insert(i as u32, fat[i]).unwrap();
+            }
+            member[i] = !member[i];
+        }
+        let moved: Vec<u32> = (0..N as u32).filter(|_| r.random::<f64>() < 0.8).collect();
+        for &i in &moved {
+            let i = i as usize;
+            let step = Vec3A::new(r.random(), r.random(), r.random()) * 1.2 - 0.6;
+            crowd.centre[i] = (crowd.centre[i] + step).clamp(Vec3A::ZERO, Vec3A::splat(10.0));
+            let was_parked = fat[i].min.x.is_nan();
+            fat[i] = if r.random::<f64>() < 0.03 {
+                Aabb3::NAN
+            } else {
+                Aabb3::new(
+                    crowd.centre[i] - crowd.extent[i],
+                    crowd.centre[i] + crowd.extent[i],
+                )
+            };
+            if member[i] {
+                parked += usize::from(!was_parked && fat[i].min.x.is_nan());
+                unparked += usize::from(was_parked && !fat[i].min.x.is_nan());
+            }
+        }
+        tree.update(&moved, &fat, &mut pairs).unwrap();
+        refused += pairs.refused.len();
+        let now = brute_force(&fat, &present(&fat, &member));
+        check(frame, &pairs, &before, &now, &tree);
+        before = now;
+    }
+    assert!(
+        parked > 100 && unparked > 100 && refused > 100,
+        "parked {parked}, unparked {unparked}, refused {refused}"
+    );
+}
+
+#[test]
 fn few_movers_among_many_take_the_queries_and_agree_with_brute_force() {
     // Under a sixteenth of the proxies changing, a report queries each changed proxy's box
     // rather than traversing the tree against itself: 2000 boxes, 40 of them jumping each

@@ -6,8 +6,10 @@
 //! the union of the node's slots: boxes are combined with `min` and `max` only, which
 //! round nothing. A new box enlarges the slots above it up to the first that already
 //! contains it ([`Hierarchy::set`], Box2D's early exit), and a remove recomputes the unions
-//! above it while they change. So a query visits every proxy whose box it overlaps. A build
-//! makes every slot exact; moves leave slots loose, never short, until the next one.
+//! above it while they change. Where most proxies move at once, each new box only marks its
+//! path ([`Hierarchy::set_leaf`]), and one pass then recomputes the marked slots from their
+//! children ([`Hierarchy::refit_marked`]). So a query visits every proxy whose box it
+//! overlaps. A build or a refit makes slots exact; moves leave slots loose, never short.
 
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
@@ -310,6 +312,47 @@ impl Hierarchy {
         node.set(slot.child(), b);
         let mark = node.mark(slot.child(), self.epoch);
         self.enlarge_above(slot.node(), b, mark);
+    }
+
+    /// Writes the box of the proxy in `slot` and marks its path as
+    /// [`Hierarchy::mark_changed`] does, leaving the slots above it short until
+    /// [`Hierarchy::refit_marked`].
+    #[inline(always)]
+    pub(crate) fn set_leaf(&mut self, slot: Slot, b: &Aabb3) {
+        self.nodes[slot.node() as usize].set(slot.child(), b);
+        self.mark_changed(slot);
+    }
+
+    /// Makes the slot of every marked node the union of its children's slots, children
+    /// first (depth first, each node after its marked child nodes), with `stack` as
+    /// scratch. Every proxy whose slot changed since the last clear must have its path
+    /// marked ([`Hierarchy::set_leaf`], [`Hierarchy::set`]): then every slot contains its
+    /// node's union again, exactly on the marked paths, and loose as before elsewhere.
+    pub(crate) fn refit_marked(&mut self, stack: &mut Vec<u64>) {
+        /// The low bit of a stack entry: the node's marked children are done.
+        const DONE: u64 = 1;
+        stack.clear();
+        stack.push(0);
+        while let Some(entry) = stack.pop() {
+            let n = (entry >> 1) as u32;
+            let node = &self.nodes[n as usize];
+            if entry & DONE == 0 {
+                stack.push(entry | DONE);
+                let mut marks = node.marks(self.epoch);
+                while marks != 0 {
+                    let k = marks.trailing_zeros() as usize;
+                    marks &= marks - 1;
+                    let c = node.child[k];
+                    if c != NONE && c & LEAF == 0 {
+                        self.prefetch_node(c);
+                        stack.push(u64::from(c) << 1);
+                    }
+                }
+            } else if node.parent.0 != NONE {
+                let (parent, union) = (node.parent, node.union());
+                self.nodes[parent.node() as usize].set(parent.child(), &union);
+            }
+        }
     }
 
     /// Enlarges the slots above node `n` to contain `b`, up to the first that does, and
