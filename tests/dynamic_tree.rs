@@ -5,7 +5,7 @@
 
 use std::collections::BTreeSet;
 
-use bvkit::broadphase::{BroadphaseError, DynamicTree, Pairs};
+use bvkit::broadphase::{BroadphaseError, DynamicTree, Layers, Pairs};
 use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3, Rounding};
 use glam::{Quat, Vec3A};
 use rand::rngs::StdRng;
@@ -557,7 +557,8 @@ fn a_build_fills_its_nodes() {
         // And every proxy is still found by its own box.
         for (i, b) in boxes.iter().enumerate() {
             let mut found = false;
-            tree.query(b, |id| found |= id == i as u32);
+            tree.query(b, Layers::ALL, |id| found |= id == i as u32)
+                .unwrap();
             assert!(found, "{n} proxies: proxy {i} lost");
         }
     }
@@ -582,12 +583,15 @@ fn empty_boxes_stay_out_and_queries_see_only_proxies() {
     // A query reaching everything, infinite faces included, finds exactly the proxies.
     let everything = Aabb3::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
     let mut hits = vec![];
-    tree.query(&everything, |id| hits.push(id));
+    tree.query(&everything, Layers::ALL, |id| hits.push(id))
+        .unwrap();
     hits.sort();
     let expected: Vec<u32> = (0..1001).filter(|&i| i != 5).collect();
     assert_eq!(hits, expected);
     let mut none = vec![];
-    DynamicTree::new().query(&everything, |id| none.push(id));
+    DynamicTree::new()
+        .query(&everything, Layers::ALL, |id| none.push(id))
+        .unwrap();
     assert!(none.is_empty());
 }
 
@@ -666,9 +670,8 @@ fn a_bad_box_at_update_parks_its_proxy_until_a_good_one_comes() {
         assert_eq!(pairs.ended, [(0, 1)]);
         assert!(tree.is_parked(1) && tree.contains(1) && tree.get(1).is_none());
         let mut hits = vec![];
-        tree.query(&Aabb3::new(Vec3A::splat(-1e30), Vec3A::splat(1e30)), |id| {
-            hits.push(id)
-        });
+        let all = Aabb3::new(Vec3A::splat(-1e30), Vec3A::splat(1e30));
+        tree.query(&all, Layers::ALL, |id| hits.push(id)).unwrap();
         hits.sort();
         assert_eq!(hits, [0, 2]);
         // A rebuild and another bad box change nothing.
@@ -711,4 +714,154 @@ fn bad_moved_lists_are_errors_before_any_change() {
     // The pending first frame is still there.
     tree.update(&[], &fat, &mut pairs).unwrap();
     assert_eq!(as_set(&pairs.begun), Set::from([(0, 1), (0, 2), (1, 2)]));
+}
+
+/// Kinds, layers, box and point queries and every other operation (inserts of any kind,
+/// removes, writes with any boxes, changes of kind, layers and kind pairs, rebuilds whole
+/// and spread) against the brute-force referee, over random sequences: every report's
+/// begun and ended pairs, every query's hits, every proxy's state, kind and layers, and
+/// every pair after every operation.
+#[test]
+fn kinds_layers_and_queries_agree_with_brute_force_over_random_sequences() {
+    use bvkit_support::referee::{Check, Op};
+    let (mut begun, mut ended, mut reports) = (0, 0, 0);
+    for seed in 0..96 {
+        let mut r = StdRng::seed_from_u64(seed);
+        let mut byte = || r.random::<u8>();
+        let mut check = Check::new(40);
+        for _ in 0..300 {
+            let op = Op::decode(&mut byte, 40);
+            check.apply(&op, true);
+        }
+        check.apply(&Op::Report, true);
+        (begun, ended, reports) = (
+            begun + check.begun,
+            ended + check.ended,
+            reports + check.reports,
+        );
+    }
+    // Not vacuous: many reports, with pairs beginning and ending.
+    assert!(
+        reports > 2000 && begun > 2000 && ended > 2000,
+        "{reports} {begun} {ended}"
+    );
+}
+
+/// The same over long sequences whose boxes are all well formed and which report after
+/// every few operations, with kinds and layers in play: few parked proxies, many pairs.
+#[test]
+fn long_sequences_of_kinds_and_layers_agree_with_brute_force() {
+    use bvkit_support::referee::{Check, Op};
+    let mut r = StdRng::seed_from_u64(85);
+    let mut check = Check::new(40);
+    let mut byte = || r.random::<u8>();
+    for step in 0..6000 {
+        let op = match Op::decode(&mut byte, 40) {
+            // Only well-formed boxes here.
+            Op::Insert { fat, .. } | Op::Query(fat, _) if !fat.min.cmple(fat.max).all() => {
+                continue;
+            }
+            op => op,
+        };
+        check.apply(&op, step % 16 == 0);
+        if step % 5 == 0 {
+            check.apply(&Op::Report, false);
+        }
+    }
+    check.check_state();
+    assert!(check.begun > 1000 && check.ended > 1000);
+}
+
+/// A level: 1,500 static boxes, 500 dynamic and 50 kinematic ones among them, in three
+/// layers, moving for 60 frames (a few movers in some frames, so that the report queries
+/// each changed proxy, and most in others, so that it traverses the hierarchies, deep
+/// enough to run the traversals' depth-first tasks), with statics teleported, kinds and
+/// layers changed and the kind pairs switched on the way: every report against brute
+/// force.
+#[test]
+fn a_level_with_moving_bodies_in_layers_agrees_with_brute_force() {
+    use bvkit::broadphase::{BodyKind, KindPairs};
+    use bvkit_support::referee::{Check, Op};
+    const N: u32 = 2050;
+    let mut r = StdRng::seed_from_u64(86);
+    let mut check = Check::new(N as usize);
+    let mut boxes: Vec<Aabb3> = (0..N)
+        .map(|_| {
+            let c = Vec3A::new(
+                r.random_range(0.0..40.0),
+                r.random_range(0.0..40.0),
+                r.random_range(0.0..4.0),
+            );
+            let e = Vec3A::new(
+                r.random_range(0.2..1.0),
+                r.random_range(0.2..1.0),
+                r.random_range(0.2..1.0),
+            );
+            Aabb3::new(c - e, c + e)
+        })
+        .collect();
+    let kind = |id: u32| match id {
+        0..1500 => BodyKind::Static,
+        1500..2000 => BodyKind::Dynamic,
+        _ => BodyKind::Kinematic,
+    };
+    for id in 0..N {
+        let layers = Layers::new(1 << (id % 3), if id % 7 == 0 { 0b011 } else { 0b111 });
+        let op = Op::Insert {
+            id,
+            fat: boxes[id as usize],
+            kind: kind(id),
+            layers,
+        };
+        check.apply(&op, false);
+    }
+    check.apply(&Op::Report, true);
+    for frame in 0..60 {
+        let share = if frame % 3 == 0 { 0.01 } else { 0.8 };
+        let mut moved = Vec::new();
+        for id in 0..N {
+            let moves = match kind(id) {
+                BodyKind::Static => r.random_bool(0.002),
+                _ => r.random_bool(share),
+            };
+            if moves {
+                let step = Vec3A::new(
+                    r.random_range(-0.6..0.6),
+                    r.random_range(-0.6..0.6),
+                    r.random_range(-0.3..0.3),
+                );
+                let b = &mut boxes[id as usize];
+                *b = Aabb3::new(b.min + step, b.max + step);
+                moved.push((id, *b));
+            }
+        }
+        check.apply(&Op::Write(moved), false);
+        match frame % 10 {
+            2 => check.apply(&Op::SetKind(r.random_range(0..N), BodyKind::Dynamic), false),
+            4 => check.apply(
+                &Op::SetKind(r.random_range(1500..N), BodyKind::Static),
+                false,
+            ),
+            5 => check.apply(
+                &Op::SetLayers(r.random_range(0..N), Layers::new(2, 2)),
+                false,
+            ),
+            7 => check.apply(
+                &Op::SetKindPairs(KindPairs {
+                    kinematic_kinematic: frame % 20 == 7,
+                    kinematic_static: true,
+                }),
+                false,
+            ),
+            _ => {}
+        }
+        check.apply(&Op::Maintain(4), false);
+        check.apply(&Op::Report, frame % 10 == 9);
+    }
+    assert!(
+        check.begun > 5000 && check.ended > 5000,
+        "{} {}",
+        check.begun,
+        check.ended
+    );
 }

@@ -173,6 +173,47 @@ impl Child {
     }
 }
 
+/// A descent's stack of nodes: on the caller's stack up to [`Stack::INLINE`] entries (a
+/// depth-first descent holds at most seven a level, so a tree of 18 levels), on the heap
+/// beyond, so that no tree, however deep its inserts made it, loses a hit.
+pub(crate) struct Stack {
+    inline: [u32; Stack::INLINE],
+    len: usize,
+    spill: Vec<u32>,
+}
+
+impl Stack {
+    const INLINE: usize = 128;
+
+    #[inline(always)]
+    pub(crate) fn new() -> Self {
+        Self {
+            inline: [0; Self::INLINE],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn push(&mut self, n: u32) {
+        if self.len < Self::INLINE {
+            self.inline[self.len] = n;
+            self.len += 1;
+        } else {
+            self.spill.push(n);
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn pop(&mut self) -> Option<u32> {
+        if let Some(n) = self.spill.pop() {
+            return Some(n);
+        }
+        self.len = self.len.checked_sub(1)?;
+        Some(self.inline[self.len])
+    }
+}
+
 /// The traversal's tasks before it runs depth first: enough to share among threads.
 const FRONTIER: usize = 256;
 
@@ -267,6 +308,11 @@ impl Hierarchy {
     /// The number of nodes in use.
     pub(crate) fn nodes(&self) -> usize {
         self.nodes.len() - self.free.len()
+    }
+
+    /// True when the hierarchy holds no proxy (its root has no child).
+    pub(crate) fn is_empty(&self) -> bool {
+        self.nodes[0].child.iter().all(|&c| c == NONE)
     }
 
     fn alloc(&mut self, parent: Slot) -> u32 {
@@ -444,14 +490,31 @@ impl Hierarchy {
         }
     }
 
-    /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with `stack` as scratch.
+    /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with a stack of its own
+    /// (no heap allocation unless the tree is deeper than [`Stack`] holds inline).
     #[inline(always)]
-    pub(crate) fn query(&self, q: &Aabb3, stack: &mut Vec<u64>, mut hit: impl FnMut(u32, &Aabb3)) {
-        self.query_group(core::slice::from_ref(q), stack, |_, id, b| hit(id, b));
+    pub(crate) fn query_one(&self, q: &Aabb3, mut hit: impl FnMut(u32, &Aabb3)) {
+        let splat = Query::new(q);
+        let mut stack = Stack::new();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            let mut bits = node.overlaps(&splat);
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                match node.child[k] {
+                    // An empty slot (+∞ below −∞) meets only a query reaching both.
+                    NONE => {}
+                    c if c & LEAF != 0 => hit(c & !LEAF, &node.get(k)),
+                    c => stack.push(c),
+                }
+            }
+        }
     }
 
     /// Calls `hit(i, id, box)` for every query `qs[i]` and every proxy whose box overlaps
-    /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query`] per box (in
+    /// it, with `stack` as scratch: the same calls as one [`Hierarchy::query_one`] per box (in
     /// another order), but the queries descend together, so a node that several of them
     /// reach is read once. Each stack entry carries the queries that reached it (a node,
     /// then a byte of them); at most [`WIDTH`] queries (more would spill into the node's
@@ -554,24 +617,70 @@ impl Hierarchy {
     pub(crate) fn changed_frontier(
         &self,
         tasks: &mut Vec<u64>,
-        mut pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
+        pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
     ) {
         tasks.clear();
         tasks.push(task_within(0));
+        self.frontier(self, tasks, pair);
+    }
+
+    /// [`Hierarchy::changed_frontier`] of the traversal of this hierarchy against `other`:
+    /// the pairs of a proxy of each with a changed one, each reached once, from the pair of
+    /// the two roots' slots that hold them (then `x` is of this hierarchy, `y` of
+    /// `other`). Run with [`Hierarchy::changed_pairs_from`] with the same `other`.
+    pub(crate) fn changed_frontier_with(
+        &self,
+        other: &Hierarchy,
+        tasks: &mut Vec<u64>,
+        pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
+    ) {
+        tasks.clear();
+        let (a, b) = (&self.nodes[0], &other.nodes[0]);
+        let (marks_a, marks_b) = (
+            u32::from(a.marks(self.epoch)),
+            u32::from(b.marks(other.epoch)),
+        );
+        for i in 0..WIDTH {
+            if a.child[i] == NONE {
+                continue;
+            }
+            let mut bits = b.overlaps(&Query::new(&a.get(i)));
+            if marks_a >> i & 1 == 0 {
+                bits &= marks_b;
+            }
+            while bits != 0 {
+                let j = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if b.child[j] != NONE {
+                    tasks.push(task_across(Slot::new(0, i), Slot::new(0, j)));
+                }
+            }
+        }
+        self.frontier(other, tasks, pair);
+    }
+
+    /// Expands `tasks` breadth first until there are at least [`FRONTIER`] or none.
+    fn frontier(
+        &self,
+        other: &Hierarchy,
+        tasks: &mut Vec<u64>,
+        mut pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
+    ) {
         let mut first = 0;
         while first < tasks.len() && tasks.len() - first < FRONTIER {
             let task = tasks[first];
             first += 1;
-            self.expand(task, &mut pair, |t| tasks.push(t));
+            self.expand(other, task, &mut pair, |t| tasks.push(t));
         }
         tasks.drain(..first);
     }
 
-    /// Runs each of `tasks` depth first (see [`Hierarchy::changed_frontier`]), with `stack`
-    /// as scratch.
+    /// Runs each of `tasks` depth first (see [`Hierarchy::changed_frontier`]; `other` is
+    /// this hierarchy for its traversal against itself), with `stack` as scratch.
     #[inline(always)]
     pub(crate) fn changed_pairs_from(
         &self,
+        other: &Hierarchy,
         tasks: &[u64],
         stack: &mut Vec<u64>,
         mut pair: impl FnMut(u32, &Aabb3, u32, &Aabb3),
@@ -580,22 +689,25 @@ impl Hierarchy {
             stack.clear();
             stack.push(task);
             while let Some(task) = stack.pop() {
-                self.expand(task, &mut pair, |t| stack.push(t));
+                self.expand(other, task, &mut pair, |t| stack.push(t));
             }
         }
     }
 
     /// One step of the traversal of pairs with a changed proxy: a task is a node whose
-    /// children's pairs are wanted ([`task_within`]), or two slots whose boxes overlap and
-    /// one of which is marked ([`task_across`]). Each pair of proxies is reached once, from
-    /// their lowest common node: within a node, each pair of its children whose boxes
-    /// overlap and one of which is marked; across two slots, the children of the one that
-    /// is a node (the larger, when both are) against the other, those that overlap it and
-    /// are marked or meet a marked one. Node boxes contain their children's, so no pair of
-    /// overlapping proxies is missed.
+    /// children's pairs are wanted ([`task_within`], only in a traversal of a hierarchy
+    /// against itself), or two slots, `x` of this hierarchy and `y` of `other`, whose boxes
+    /// overlap and one of which is marked ([`task_across`]). Each pair of proxies is
+    /// reached once, from their lowest common node (or the roots' slots that hold them):
+    /// within a node, each pair of its children whose boxes overlap and one of which is
+    /// marked; across two slots, the children of the one that is a node (the larger, when
+    /// both are) against the other, those that overlap it and are marked or meet a marked
+    /// one. Node boxes contain their children's, so no pair of overlapping proxies is
+    /// missed.
     #[inline(always)]
     fn expand(
         &self,
+        other: &Hierarchy,
         task: u64,
         pair: &mut impl FnMut(u32, &Aabb3, u32, &Aabb3),
         mut push: impl FnMut(u64),
@@ -628,20 +740,24 @@ impl Hierarchy {
         let (sx, sy) = (Slot(x), Slot(y));
         let (cx, cy) = (
             self.nodes[sx.node() as usize].child[sx.child()],
-            self.nodes[sy.node() as usize].child[sy.child()],
+            other.nodes[sy.node() as usize].child[sy.child()],
         );
-        let (bx, by) = (self.get(sx), self.get(sy));
+        let (bx, by) = (self.get(sx), other.get(sy));
         if cx & LEAF != 0 && cy & LEAF != 0 {
             pair(cx & !LEAF, &bx, cy & !LEAF, &by);
             return;
         }
         // Descend the node side: x when y is a proxy or x is the larger node.
         let x_down = cy & LEAF != 0 || (cx & LEAF == 0 && area(&bx) >= area(&by));
-        let (down, other, other_box) = if x_down { (cx, sy, by) } else { (cy, sx, bx) };
-        let node = &self.nodes[down as usize];
-        let mut bits = node.overlaps(&Query::new(&other_box));
-        if !self.is_changed(other) {
-            bits &= u32::from(node.marks(self.epoch));
+        let (tree, down, rest, rest_box, rest_changed) = if x_down {
+            (self, cx, sy, by, other.is_changed(sy))
+        } else {
+            (other, cy, sx, bx, self.is_changed(sx))
+        };
+        let node = &tree.nodes[down as usize];
+        let mut bits = node.overlaps(&Query::new(&rest_box));
+        if !rest_changed {
+            bits &= u32::from(node.marks(tree.epoch));
         }
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
@@ -651,9 +767,9 @@ impl Hierarchy {
             }
             let s = Slot::new(down, j);
             push(if x_down {
-                task_across(s, other)
+                task_across(s, rest)
             } else {
-                task_across(other, s)
+                task_across(rest, s)
             });
         }
     }

@@ -89,6 +89,12 @@ impl Partners {
         })
     }
 
+    /// True when `a` and `b` are partners: a look through `a`'s list.
+    #[inline(always)]
+    pub(super) fn contains(&self, a: u32, b: u32) -> bool {
+        self.of(a).any(|x| x == b)
+    }
+
     /// Makes `a` and `b` partners (they must not be already).
     pub(super) fn add(&mut self, a: u32, b: u32) {
         self.link(a, b);

@@ -13,6 +13,7 @@ pub mod meshes;
 #[cfg(target_arch = "x86_64")]
 pub mod mxcsr;
 pub mod oracle;
+pub mod referee;
 pub mod sat;
 pub mod timing;
 pub mod trimesh;
