@@ -26,7 +26,9 @@
 //! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
 //! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
 //! leaves R out, `--check-all` checks every frame and `--no-check` none (for profiling), `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
-//! `--rebuild-frames F` tune C's upkeep.
+//! `--rebuild-frames F` tune C's upkeep; `--level M` adds M static boxes to C's tree at the bodies'
+//! density around the scene, `--floor M` a floor of M static tiles under it, and `--layers K`
+//! puts C's proxy `i` in layer `i % K` alone (1: every proxy in one layer, through the filter).
 
 use bvkit_support::broadphase::{bvh, scene};
 use bvkit_support::common;
@@ -59,6 +61,12 @@ fn main() {
         partial: option("--partial").unwrap_or(0.0) as usize,
         rebuild_after: option("--rebuild-after").map(|x| x as f32),
         rebuild_frames: option("--rebuild-frames").map(|x| x as u32),
+        level: match (option("--level"), option("--floor")) {
+            (Some(m), _) => bvh::Level::Clutter(m as usize),
+            (None, Some(m)) => bvh::Level::Floor(m as usize),
+            (None, None) => bvh::Level::None,
+        },
+        layers: option("--layers").unwrap_or(0.0) as u32,
     };
     let speed = option("--speed").unwrap_or(1.0) as f32;
     // `--name`, taken out of the positional arguments.

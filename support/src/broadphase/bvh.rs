@@ -47,7 +47,7 @@
 use std::collections::HashSet;
 use std::time::Instant;
 
-use bvkit::broadphase::{DynamicTree, Pairs};
+use bvkit::broadphase::{BodyKind, DynamicTree, Layers, Pairs};
 use bvkit::{Aabb3, Aabb3x8, Active, Batch, Margin, Method, Moved, Rigid3x8, Rounding};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
@@ -86,6 +86,78 @@ pub struct Tuning {
     pub rebuild_after: Option<f32>,
     /// C's `DynamicTree::set_rebuild_frames`, where given.
     pub rebuild_frames: Option<u32>,
+    /// Static boxes C's tree holds beside the bodies (`Level`), none by default.
+    pub level: Level,
+    /// C's layers: 0 (the default) every proxy in every layer; `k` proxy `i` in layer
+    /// `i % k` only, pairing with it only (so 1 puts every proxy in one layer, through the
+    /// filter's checks).
+    pub layers: u32,
+}
+
+/// A level of static boxes in C's tree, which the bodies move among.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Level {
+    #[default]
+    None,
+    /// `n` boxes of the bodies' sizes at the bodies' density (1M per km³), in a cube
+    /// centred on the scene (1 km wide for 1M): the bodies meet as many static boxes as
+    /// bodies, and most static boxes are far from every body.
+    Clutter(usize),
+    /// A floor of `n` tiles (a square grid, 1 unit thick, with gaps of a tenth of a tile)
+    /// under the scene, its top at the scene's bottom plus one unit: only the lowest
+    /// bodies touch it.
+    Floor(usize),
+}
+
+impl Level {
+    /// The level's boxes, for a scene of `n` bodies.
+    pub fn boxes(self, n: usize) -> Vec<Aabb3> {
+        use glam::Vec3A;
+        use rand::{RngExt, SeedableRng};
+        let half = 500.0 * (n as f32 / 1e6).cbrt();
+        let mut r = rand::rngs::StdRng::seed_from_u64(0x1e7e1);
+        match self {
+            Level::None => Vec::new(),
+            Level::Clutter(m) => {
+                let side = 500.0 * (m as f32 / 1e6).cbrt();
+                (0..m)
+                    .map(|_| {
+                        let e = Vec3A::new(
+                            r.random_range(0.1..1.0),
+                            r.random_range(0.1..1.0),
+                            r.random_range(0.1..1.0),
+                        );
+                        let c = Vec3A::new(
+                            r.random_range(-side..side),
+                            r.random_range(-side..side),
+                            r.random_range(-side..side),
+                        );
+                        Aabb3::new(c - e, c + e)
+                    })
+                    .collect()
+            }
+            Level::Floor(m) => {
+                let k = (m as f64).sqrt().ceil() as usize;
+                let pitch = 2.0 * half / k as f32;
+                (0..m)
+                    .map(|t| {
+                        let (i, j) = ((t / k) as f32, (t % k) as f32);
+                        let min = Vec3A::new(-half + i * pitch, -half, -half + j * pitch);
+                        let size = Vec3A::new(0.9 * pitch, 1.0, 0.9 * pitch);
+                        Aabb3::new(min, min + size)
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// Proxy `id`'s layers under `Tuning::layers`.
+fn layers_of(id: u32, layers: u32) -> Layers {
+    match layers {
+        0 => Layers::ALL,
+        k => Layers::new(1 << (id % k), 1 << (id % k)),
+    }
 }
 
 impl Tree {
@@ -153,6 +225,8 @@ struct Dynamic {
     moved: Moved,
     tree: DynamicTree,
     pairs: Pairs,
+    /// The level's static boxes, proxies `8 * fat.len()` on.
+    statics: Vec<Aabb3>,
     /// The frame last checked and the pairs of the tree's boxes then (the reference's).
     checked: Option<(usize, HashSet<(u32, u32)>)>,
 }
@@ -275,7 +349,19 @@ impl Pipelines {
         });
         let mut mask8 = scene.mask.clone();
         mask8.resize((8 * local8.len()).div_ceil(64), 0);
-        let mut tree = DynamicTree::from_boxes(&fat[..]).expect("finite fat boxes");
+        // The level's static proxies after the bodies' blocks, both hierarchies built.
+        let statics = tuning.level.boxes(n);
+        let first_static = 8 * fat.len();
+        let mut all = Aabb3x8::unpack(&fat, first_static);
+        all.extend_from_slice(&statics);
+        let mut tree = DynamicTree::from_boxes_with(&all[..], |id| {
+            let kind = match id as usize >= first_static {
+                true => BodyKind::Static,
+                false => BodyKind::Dynamic,
+            };
+            (kind, layers_of(id, tuning.layers))
+        })
+        .expect("finite fat boxes");
         if let Some(after) = tuning.rebuild_after {
             tree.set_rebuild_after(after);
         }
@@ -293,6 +379,7 @@ impl Pipelines {
             moved,
             tree,
             pairs,
+            statics,
             checked: None,
         };
         let r = which.rapier.then(|| Rapier::new(scene));
@@ -441,8 +528,19 @@ impl Pipelines {
     /// with), and keeps this frame's pairs for the next check.
     pub fn check_c(&mut self, n: usize) -> (usize, usize) {
         let c = &mut self.c;
-        let boxes: Vec<Aabb> = Aabb3x8::unpack(&c.fat, n).iter().map(parry_box).collect();
-        let now = (self.frames, overlapping(&boxes));
+        let layers = self.tuning.layers;
+        let now = if c.statics.is_empty() && layers == 0 {
+            let boxes: Vec<Aabb> = Aabb3x8::unpack(&c.fat, n).iter().map(parry_box).collect();
+            overlapping(&boxes)
+        } else {
+            let bodies = Aabb3x8::unpack(&c.fat, 8 * c.fat.len());
+            let admit = |a: u32, b: u32| layers_of(a, layers).interacts_with(layers_of(b, layers));
+            pairs_with_level(&bodies, &c.statics)
+                .into_iter()
+                .filter(|&(a, b)| admit(a, b))
+                .collect()
+        };
+        let now = (self.frames, now);
         let Some((then, before)) = c.checked.replace(now) else {
             return (0, 0);
         };
@@ -459,6 +557,50 @@ impl Pipelines {
             begun.difference(&expected_begun).count() + ended.difference(&expected_ended).count(),
         )
     }
+}
+
+/// Every pair of overlapping boxes (closed) among `bodies` (proxies `0..`) and between them
+/// and `statics` (proxies `bodies.len()..`), never two static ones: by a grid of cells of 2
+/// units, each box listed in every cell it meets.
+fn pairs_with_level(bodies: &[Aabb3], statics: &[Aabb3]) -> HashSet<(u32, u32)> {
+    use std::collections::HashMap;
+    const CELL: f32 = 2.0;
+    let cells = |b: &Aabb3| {
+        let (lo, hi) = ((b.min / CELL).floor(), (b.max / CELL).floor());
+        let (lo, hi) = (lo.as_ivec3(), hi.as_ivec3());
+        (lo.x..=hi.x).flat_map(move |x| {
+            (lo.y..=hi.y).flat_map(move |y| (lo.z..=hi.z).map(move |z| (x, y, z)))
+        })
+    };
+    let all = |id: usize| match id.checked_sub(bodies.len()) {
+        None => &bodies[id],
+        Some(s) => &statics[s],
+    };
+    let mut grid: HashMap<(i32, i32, i32), Vec<u32>> = HashMap::new();
+    for id in 0..bodies.len() + statics.len() {
+        let b = all(id);
+        if b.min.x <= b.max.x {
+            for cell in cells(b) {
+                grid.entry(cell).or_default().push(id as u32);
+            }
+        }
+    }
+    let overlap = |a: &Aabb3, b: &Aabb3| a.min.cmple(b.max).all() && b.min.cmple(a.max).all();
+    let mut pairs = HashSet::new();
+    for (id, b) in bodies.iter().enumerate() {
+        if b.min.x > b.max.x {
+            continue;
+        }
+        for cell in cells(b) {
+            for &other in &grid[&cell] {
+                if other as usize != id && overlap(b, all(other as usize)) {
+                    let id = id as u32;
+                    pairs.insert((id.min(other), id.max(other)));
+                }
+            }
+        }
+    }
+    pairs
 }
 
 /// What a run measured: the mean frame of each pipeline (ms; A, B, C, D, R, zero for those
