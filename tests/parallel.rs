@@ -140,9 +140,10 @@ fn parallel_length_mismatch_writes_nothing() {
 /// A dense crowd where a share of the bodies jump every frame, a few of them to a NaN box
 /// (parked) and back, run through one tree with `update` and through others with
 /// `update_par` on pools of 1 to 4 threads: every frame's begun, ended and refused lists
-/// are the same, in the same order. Half of 12K moving takes the report's traversal of the
-/// tree against itself (hundreds of tasks, eight a part); a twentieth of 20K, its queries
-/// (a thousand, 512 a part).
+/// are the same, in the same order. Half of 12K moving takes the report's traversals of the
+/// moving hierarchy against itself and against the static one (hundreds of tasks, eight a
+/// part); a twentieth of 20K, its queries (a thousand, 512 a part). A fifth of the proxies
+/// are static and a tenth kinematic (paired with statics), in two layers.
 #[test]
 fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() {
     same_pairs_on_any_number_of_threads(12_000, 0.5);
@@ -150,7 +151,7 @@ fn the_tree_reports_the_same_pairs_in_the_same_order_on_any_number_of_threads() 
 }
 
 fn same_pairs_on_any_number_of_threads(n: usize, share: f64) {
-    use bvkit::broadphase::{DynamicTree, Pairs};
+    use bvkit::broadphase::{BodyKind, DynamicTree, KindPairs, Layers, Pairs};
     use glam::Vec3A;
     let mut r = rng(68);
     let extent: Vec<Vec3A> = (0..n)
@@ -170,7 +171,22 @@ fn same_pairs_on_any_number_of_threads(n: usize, share: f64) {
     };
     let mut fat = boxes(&centre);
     let pools = pools(4);
-    let mut serial = DynamicTree::from_boxes(&fat).unwrap();
+    let mut serial = DynamicTree::from_boxes_with(&fat, |id| {
+        let kind = match id % 10 {
+            0 | 5 => BodyKind::Static,
+            3 => BodyKind::Kinematic,
+            _ => BodyKind::Dynamic,
+        };
+        (
+            kind,
+            Layers::new(1 << (id % 2), if id % 7 == 0 { 1 } else { 3 }),
+        )
+    })
+    .unwrap();
+    serial.set_kind_pairs(KindPairs {
+        kinematic_kinematic: false,
+        kinematic_static: true,
+    });
     let mut parallel: Vec<DynamicTree> = pools.iter().map(|_| serial.clone()).collect();
     let (mut begun, mut ended) = (0, 0);
     for frame in 0..12 {
@@ -300,6 +316,58 @@ fn the_update_gives_the_same_fat_boxes_and_moved_set_on_any_number_of_threads() 
             assert!(want.1.len() > 500, "frame {frame}: {} moved", want.1.len());
         }
     }
+}
+
+/// Many rays cast with `cast_rays_par` on pools of 1 to 4 threads, their closest hits and
+/// every hit in call order: the same as `cast_rays` and as one `cast_ray` at a time.
+#[test]
+fn many_rays_give_the_same_hits_in_the_same_order_on_any_number_of_threads() {
+    use bvkit::broadphase::{BodyKind, CastControl, DynamicTree, Layers, Ray};
+    use glam::Vec3A;
+    let mut r = rng(85);
+    let fat: Vec<Aabb3> = (0..20_000)
+        .map(|_| {
+            let c = Vec3A::new(r.random(), r.random(), r.random()) * 100.0;
+            Aabb3::new(c - 0.8, c + 0.8)
+        })
+        .collect();
+    let tree = DynamicTree::from_boxes_with(&fat, |id| {
+        let kind = [BodyKind::Static, BodyKind::Dynamic][id as usize % 2];
+        (kind, Layers::new(1 << (id % 3), u32::MAX))
+    })
+    .unwrap();
+    let rays: Vec<Ray> = (0..3000)
+        .map(|_| {
+            let origin = Vec3A::new(r.random(), r.random(), r.random()) * 100.0;
+            let direction = Vec3A::new(r.random(), r.random(), r.random()) - 0.5;
+            Ray::new(origin, direction, 150.0)
+        })
+        .collect();
+    let layers = Layers::new(u32::MAX, 0b101);
+    // Each ray's hits in call order, clipping to the nearest entry so far.
+    type Hits = Vec<(u32, u32)>;
+    let record = |_: usize, id: u32, t: f32, out: &mut Hits| {
+        out.push((id, t.to_bits()));
+        let nearest = out.iter().map(|h| f32::from_bits(h.1)).fold(t, f32::min);
+        CastControl::Clip(nearest + 5.0)
+    };
+    let mut one_by_one: Vec<Hits> = vec![Vec::new(); rays.len()];
+    for (i, ray) in rays.iter().enumerate() {
+        let out = &mut one_by_one[i];
+        tree.cast_ray(ray, layers, |id, t| record(i, id, t, out))
+            .unwrap();
+    }
+    let mut serial: Vec<Hits> = vec![Vec::new(); rays.len()];
+    tree.cast_rays(&rays, layers, &mut serial, record).unwrap();
+    assert_eq!(serial, one_by_one);
+    for pool in pools(4) {
+        let mut got: Vec<Hits> = vec![Vec::new(); rays.len()];
+        pool.install(|| tree.cast_rays_par(&rays, layers, &mut got, record))
+            .unwrap();
+        assert_eq!(got, serial, "{} threads", pool.current_num_threads());
+    }
+    let hits: usize = serial.iter().map(Vec::len).sum();
+    assert!(hits > 3000, "{hits} hits");
 }
 
 /// Thread pools of 1 to `most` threads.

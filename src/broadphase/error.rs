@@ -48,6 +48,16 @@ pub enum BroadphaseError {
     /// A query box or point with a NaN face or coordinate, or a box with a face below its
     /// opposite one: nothing was searched.
     InvalidQuery,
+    /// A cast with a NaN or infinite origin, direction or motion, a zero ray direction, a
+    /// NaN or negative length, or a bad moving box: nothing was cast.
+    InvalidCast,
+    /// A batch of casts whose output is not as long as its rays: nothing was cast.
+    OutputLength {
+        /// The rays.
+        rays: usize,
+        /// The output's length.
+        len: usize,
+    },
 }
 
 impl fmt::Display for BroadphaseError {
@@ -70,6 +80,14 @@ impl fmt::Display for BroadphaseError {
             }
             Self::Layout => write!(f, "the fat boxes' columns disagree in length"),
             Self::UnknownId { id } => write!(f, "proxy {id} is not in the tree"),
+            Self::InvalidCast => write!(
+                f,
+                "the cast has a NaN or infinite origin, direction or motion, a zero ray \
+                 direction, a NaN or negative length, or a bad box"
+            ),
+            Self::OutputLength { rays, len } => {
+                write!(f, "{rays} rays but an output of {len}")
+            }
             Self::InvalidQuery => {
                 write!(
                     f,

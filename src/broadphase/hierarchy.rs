@@ -11,6 +11,7 @@
 //! children ([`Hierarchy::refit_marked`]). So a query visits every proxy whose box it
 //! overlaps. A build or a refit makes slots exact; moves leave slots loose, never short.
 
+use super::slab::Sweep;
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
 use core::mem::take;
@@ -173,41 +174,42 @@ impl Child {
     }
 }
 
-/// A descent's stack of nodes: on the caller's stack up to [`Stack::INLINE`] entries (a
-/// depth-first descent holds at most seven a level, so a tree of 18 levels), on the heap
-/// beyond, so that no tree, however deep its inserts made it, loses a hit.
-pub(crate) struct Stack {
-    inline: [u32; Stack::INLINE],
+/// A descent's stack: on the caller's stack up to [`STACK_INLINE`] entries (a depth-first
+/// descent holds at most seven a level, so a tree of 18 levels), on the heap beyond, so
+/// that no tree, however deep its inserts made it, loses a hit.
+pub(crate) struct Stack<T> {
+    inline: [T; STACK_INLINE],
     len: usize,
-    spill: Vec<u32>,
+    spill: Vec<T>,
 }
 
-impl Stack {
-    const INLINE: usize = 128;
+/// The entries a [`Stack`] holds on the caller's stack.
+const STACK_INLINE: usize = 128;
 
+impl<T: Copy + Default> Stack<T> {
     #[inline(always)]
     pub(crate) fn new() -> Self {
         Self {
-            inline: [0; Self::INLINE],
+            inline: [T::default(); STACK_INLINE],
             len: 0,
             spill: Vec::new(),
         }
     }
 
     #[inline(always)]
-    pub(crate) fn push(&mut self, n: u32) {
-        if self.len < Self::INLINE {
-            self.inline[self.len] = n;
+    pub(crate) fn push(&mut self, x: T) {
+        if self.len < STACK_INLINE {
+            self.inline[self.len] = x;
             self.len += 1;
         } else {
-            self.spill.push(n);
+            self.spill.push(x);
         }
     }
 
     #[inline(always)]
-    pub(crate) fn pop(&mut self) -> Option<u32> {
-        if let Some(n) = self.spill.pop() {
-            return Some(n);
+    pub(crate) fn pop(&mut self) -> Option<T> {
+        if let Some(x) = self.spill.pop() {
+            return Some(x);
         }
         self.len = self.len.checked_sub(1)?;
         Some(self.inline[self.len])
@@ -491,11 +493,11 @@ impl Hierarchy {
     }
 
     /// Calls `hit(id, box)` for every proxy whose box overlaps `q`, with a stack of its own
-    /// (no heap allocation unless the tree is deeper than [`Stack`] holds inline).
+    /// (no heap allocation unless the tree is deeper than a [`Stack`] holds inline).
     #[inline(always)]
     pub(crate) fn query_one(&self, q: &Aabb3, mut hit: impl FnMut(u32, &Aabb3)) {
         let splat = Query::new(q);
-        let mut stack = Stack::new();
+        let mut stack = Stack::<u32>::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
@@ -511,6 +513,61 @@ impl Hierarchy {
                 }
             }
         }
+    }
+
+    /// Runs a cast ([`Sweep`]) through the hierarchy: calls `hit(id, entry, limit)` for
+    /// every proxy whose box it may meet within `*limit` (every one the exact cast meets),
+    /// with a bound on its entry never beyond the exact entry; `hit` may lower `*limit`
+    /// (a clip), and returns false to stop the cast. The children of a node are taken
+    /// nearest entry first, and any whose entry has passed the limit by then are skipped.
+    /// Returns false when `hit` stopped it.
+    #[inline(always)]
+    pub(crate) fn cast(
+        &self,
+        sweep: &Sweep,
+        limit: &mut f64,
+        mut hit: impl FnMut(u32, f64, &mut f64) -> bool,
+    ) -> bool {
+        let mut stack = Stack::<(f64, u32)>::new();
+        stack.push((0.0, 0));
+        while let Some((entry, c)) = stack.pop() {
+            if entry > *limit {
+                continue;
+            }
+            if c & LEAF != 0 {
+                if !hit(c & !LEAF, entry, limit) {
+                    return false;
+                }
+                continue;
+            }
+            let node = &self.nodes[c as usize];
+            let (enter, mut bits) = sweep.test(&node.min, &node.max, *limit);
+            // The children met, by entry (insertion into at most eight).
+            let (mut order, mut len) = ([0usize; WIDTH], 0);
+            while bits != 0 {
+                let k = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if node.child[k] == NONE {
+                    continue;
+                }
+                let mut i = len;
+                while i > 0 && enter[order[i - 1]] > enter[k] {
+                    order[i] = order[i - 1];
+                    i -= 1;
+                }
+                order[i] = k;
+                len += 1;
+            }
+            // Farthest pushed first, so that the nearest is taken next.
+            for &k in order[..len].iter().rev() {
+                let c = node.child[k];
+                if c & LEAF == 0 {
+                    self.prefetch_node(c);
+                }
+                stack.push((enter[k], c));
+            }
+        }
+        true
     }
 
     /// Calls `hit(i, id, box)` for every query `qs[i]` and every proxy whose box overlaps
@@ -1036,6 +1093,21 @@ mod tests {
     impl Places for Slots {
         fn place(&mut self, id: u32, slot: Slot) {
             self.0[id as usize] = slot.0;
+        }
+    }
+
+    /// A stack gives its entries back last in, first out, past its inline part too.
+    #[test]
+    fn a_stack_spills_to_the_heap_and_loses_nothing() {
+        let mut stack = Stack::<u32>::new();
+        for round in 0..2 {
+            for x in 0..1000 {
+                stack.push(x);
+            }
+            for x in (0..1000).rev() {
+                assert_eq!(stack.pop(), Some(x), "round {round}");
+            }
+            assert_eq!(stack.pop(), None);
         }
     }
 

@@ -65,6 +65,7 @@
 //! other. (A second hierarchy for the sleeping proxies was measured and dropped: every
 //! moved proxy must query both, which cost more than the smaller rebuilds saved.)
 
+mod cast;
 mod edit;
 mod error;
 mod filter;
@@ -73,8 +74,10 @@ mod partners;
 mod query;
 mod rebuild;
 mod report;
+mod slab;
 mod write;
 
+pub use cast::{CastControl, Ray};
 pub use error::BroadphaseError;
 pub use filter::{BodyKind, KindPairs, Layers};
 pub use report::Pairs;

@@ -15,7 +15,8 @@ use core::mem::take;
 
 /// What a frame of [`DynamicTree::update`] found. Each pair is `(smaller id, larger id)`,
 /// once; the order of the pairs is deterministic but unspecified. A pair is counted only
-/// where the proxies' kinds and layers admit it ([`BodyKind`], [`Layers`]).
+/// where the proxies' kinds and layers admit it ([`BodyKind`](super::BodyKind),
+/// [`Layers`](super::Layers)).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Pairs {
     /// The admitted pairs whose fat boxes overlap now, and did not (or were not admitted)

@@ -6,8 +6,13 @@
 use std::collections::BTreeSet;
 
 use bvkit::Aabb3;
-use bvkit::broadphase::{BodyKind, BroadphaseError, DynamicTree, KindPairs, Layers, Pairs};
+use bvkit::broadphase::{
+    BodyKind, BroadphaseError, CastControl, DynamicTree, KindPairs, Layers, Pairs, Ray,
+};
 use glam::Vec3A;
+use num_bigint::BigInt;
+
+use crate::oracle::Exact;
 
 /// What the referee knows of a proxy's box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +47,10 @@ pub enum Op {
     SetKindPairs(KindPairs),
     Query(Aabb3, Layers),
     QueryPoint(Vec3A, Layers),
+    /// A ray cast (all hits), checked against the exact referee.
+    CastRay(Ray, Layers),
+    /// A box moving along a vector up to a length.
+    CastBox(Aabb3, Vec3A, f32, Layers),
     Rebuild,
     /// The upkeep, a rebuild once anything moved, spread over this many calls.
     Maintain(u32),
@@ -67,6 +76,136 @@ pub fn kinds_admit(k: KindPairs, a: BodyKind, b: BodyKind) -> bool {
         (Kinematic, Static) | (Static, Kinematic) => k.kinematic_static,
         (Static, Static) => false,
     }
+}
+
+/// An exact fraction `n / d`, `d > 0`.
+#[derive(Clone, Debug)]
+pub struct Frac {
+    n: BigInt,
+    d: BigInt,
+}
+
+impl Frac {
+    fn new(n: BigInt, d: BigInt) -> Self {
+        if d < BigInt::ZERO {
+            Frac { n: -n, d: -d }
+        } else {
+            Frac { n, d }
+        }
+    }
+
+    /// The exact value of a finite `f32`.
+    pub fn of(x: f32) -> Self {
+        Frac::new(big(x), big(1.0))
+    }
+
+    /// `self <= other`, exactly.
+    pub fn le(&self, other: &Frac) -> bool {
+        &self.n * &other.d <= &other.n * &self.d
+    }
+
+    /// The nearest `f64` (for messages and tolerances).
+    pub fn to_f64(&self) -> f64 {
+        use num_traits::ToPrimitive;
+        // Both scaled down together until they fit.
+        let shift = self
+            .d
+            .bits()
+            .saturating_sub(900)
+            .max(self.n.bits().saturating_sub(900));
+        let (n, d) = (&self.n >> shift, &self.d >> shift);
+        n.to_f64().unwrap_or(f64::NAN) / d.to_f64().unwrap_or(f64::NAN)
+    }
+}
+
+/// A finite `f32` as an integer, scaled by the oracle's `2^SCALE`.
+fn big(x: f32) -> BigInt {
+    match Exact::of(x) {
+        Exact::Finite(b) => b,
+        _ => panic!("a finite value"),
+    }
+}
+
+/// The exact entry of the box `[lo, hi]` moving along `d` for `t` in `[0, max]` into box
+/// `p` (a ray when `lo = hi`): the least `t` at which they share a point, or `None` when
+/// they never do. All inputs finite but `max`, which may be `+∞`.
+pub fn exact_entry(lo: Vec3A, hi: Vec3A, d: Vec3A, max: f32, p: &Aabb3) -> Option<Frac> {
+    let mut enter = Frac::of(0.0);
+    let mut exit = (max != f32::INFINITY).then(|| Frac::of(max));
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            if !(p.min[a] <= hi[a] && lo[a] <= p.max[a]) {
+                return None;
+            }
+            continue;
+        }
+        let t0 = Frac::new(big(p.min[a]) - big(hi[a]), big(d[a]));
+        let t1 = Frac::new(big(p.max[a]) - big(lo[a]), big(d[a]));
+        let (near, far) = if d[a] > 0.0 { (t0, t1) } else { (t1, t0) };
+        if enter.le(&near) {
+            enter = near;
+        }
+        exit = match exit {
+            Some(e) if e.le(&far) => Some(e),
+            _ => Some(far),
+        };
+    }
+    match exit {
+        Some(e) if !enter.le(&e) => None,
+        _ => Some(enter),
+    }
+}
+
+/// Checks a cast's hits (each proxy and its entry, all hits taken) against the exact
+/// referee over the placed proxies whose layers interact with `layers`: every proxy the
+/// exact cast meets is hit once, with an entry never beyond the exact one and within two
+/// `f32` steps of it. Returns the hits the exact cast does not meet (candidates the
+/// widened test let through), which must be rare.
+pub fn check_cast(
+    referee: &Referee,
+    (lo, hi, d, max): (Vec3A, Vec3A, Vec3A, f32),
+    layers: Layers,
+    hits: &[(u32, f32)],
+) -> usize {
+    let mut seen = BTreeSet::new();
+    for &(id, entry) in hits {
+        assert!(seen.insert(id), "proxy {id} hit twice");
+        assert!(entry >= 0.0, "proxy {id}: entry {entry} below 0");
+    }
+    let mut extra = 0;
+    for (id, p) in referee.proxies.iter().enumerate() {
+        let State::Placed(b) = p.state else {
+            assert!(!seen.contains(&(id as u32)), "proxy {id} without a box hit");
+            continue;
+        };
+        let got = hits.iter().find(|h| h.0 == id as u32).map(|h| h.1);
+        let filtered = !p.layers.interacts_with(layers);
+        match (exact_entry(lo, hi, d, max, &b), got) {
+            (_, Some(_)) if filtered => panic!("proxy {id}: hit through the layers"),
+            (Some(_), None) if filtered => {}
+            (Some(e), None) => panic!(
+                "proxy {id} {b:?} missed: exact entry {} ({lo:?} {hi:?} along {d:?} to {max})",
+                e.to_f64()
+            ),
+            (Some(e), Some(entry)) => {
+                assert!(
+                    Frac::of(entry).le(&e),
+                    "proxy {id}: entry {entry} beyond the exact {}",
+                    e.to_f64()
+                );
+                // Tight: within two f32 steps below the exact entry.
+                let floor = entry.next_up().next_up();
+                assert!(
+                    e.le(&Frac::of(floor)) || floor == f32::INFINITY,
+                    "proxy {id}: entry {entry} far below the exact {}",
+                    e.to_f64()
+                );
+            }
+            (None, Some(_)) => extra += 1,
+            (None, None) => {}
+        }
+    }
+    extra
 }
 
 /// The referee: every proxy, by id.
@@ -145,6 +284,9 @@ pub struct Check {
     pub reports: usize,
     pub begun: usize,
     pub ended: usize,
+    /// Cast hits checked, and those the exact cast does not meet.
+    pub hits: usize,
+    pub extra_hits: usize,
 }
 
 fn same(a: &Aabb3, b: &Aabb3) -> bool {
@@ -165,6 +307,8 @@ impl Check {
             reports: 0,
             begun: 0,
             ended: 0,
+            hits: 0,
+            extra_hits: 0,
         }
     }
 
@@ -271,6 +415,37 @@ impl Check {
                     assert_eq!(got, r.query(&Aabb3::new(p, p), layers), "point {p:?}");
                 }
             }
+            Op::CastRay(ray, layers) => {
+                let mut hits = Vec::new();
+                let result = self.tree.cast_ray(&ray, layers, |id, entry| {
+                    hits.push((id, entry));
+                    CastControl::Continue
+                });
+                if ray.is_valid() {
+                    assert_eq!(result, Ok(()));
+                    let cast = (ray.origin, ray.origin, ray.direction, ray.max);
+                    self.extra_hits += check_cast(r, cast, layers, &hits);
+                    self.hits += hits.len();
+                } else {
+                    assert_eq!(result, Err(BroadphaseError::InvalidCast), "ray {ray:?}");
+                    assert!(hits.is_empty());
+                }
+            }
+            Op::CastBox(b, motion, max, layers) => {
+                let mut hits = Vec::new();
+                let result = self.tree.cast_box(&b, motion, max, layers, |id, entry| {
+                    hits.push((id, entry));
+                    CastControl::Continue
+                });
+                if accepted(&b) && motion.is_finite() && max >= 0.0 {
+                    assert_eq!(result, Ok(()));
+                    self.extra_hits += check_cast(r, (b.min, b.max, motion, max), layers, &hits);
+                    self.hits += hits.len();
+                } else {
+                    assert_eq!(result, Err(BroadphaseError::InvalidCast), "box {b:?}");
+                    assert!(hits.is_empty());
+                }
+            }
             Op::Rebuild => self.tree.rebuild(),
             Op::Maintain(frames) => {
                 self.tree.set_rebuild_after(0.0);
@@ -370,6 +545,48 @@ fn any_layers(byte: &mut impl FnMut() -> u8) -> Layers {
     }
 }
 
+/// A point: mostly on the small integer grid of the boxes (on their faces and corners),
+/// sometimes a half step off it, sometimes of any bits.
+fn any_point(byte: &mut impl FnMut() -> u8) -> Vec3A {
+    match byte() % 8 {
+        0 => Vec3A::new(any_float(byte), any_float(byte), any_float(byte)),
+        1 => Vec3A::new(
+            f32::from(byte() % 20) * 0.5 - 1.0,
+            f32::from(byte() % 20) * 0.5 - 1.0,
+            f32::from(byte() % 20) * 0.5 - 1.0,
+        ),
+        _ => Vec3A::new(
+            f32::from(byte() % 10) - 1.0,
+            f32::from(byte() % 10) - 1.0,
+            f32::from(byte() % 10) - 1.0,
+        ),
+    }
+}
+
+/// A direction: mostly small integers (axis-parallel, diagonal, through corners, with
+/// zero components), sometimes tiny or huge components, sometimes of any bits.
+fn any_direction(byte: &mut impl FnMut() -> u8) -> Vec3A {
+    let mut c = || match byte() % 16 {
+        0..=3 => 0.0,
+        4 => -0.0,
+        5 => 1e-30 * f32::from(byte()),
+        6 => 1e30 * (f32::from(byte()) - 128.0),
+        7 => any_float(byte),
+        _ => f32::from(byte() % 7) - 3.0,
+    };
+    Vec3A::new(c(), c(), c())
+}
+
+/// A cast's length: mostly small, sometimes none or endless, sometimes of any bits.
+fn any_length(byte: &mut impl FnMut() -> u8) -> f32 {
+    match byte() % 8 {
+        0 => f32::INFINITY,
+        1 => 0.0,
+        2 => any_float(byte),
+        _ => f32::from(byte() % 16) * 0.5,
+    }
+}
+
 fn any_kind(byte: &mut impl FnMut() -> u8) -> BodyKind {
     match byte() % 4 {
         0 => BodyKind::Static,
@@ -379,10 +596,10 @@ fn any_kind(byte: &mut impl FnMut() -> u8) -> BodyKind {
 }
 
 impl Op {
-    /// An operation on ids `0..ids` (at most 40) from bytes: writes and reports most often.
+    /// An operation on ids `0..ids` (at most 40) from bytes: writes most often.
     pub fn decode(byte: &mut impl FnMut() -> u8, ids: u32) -> Op {
         let id = |byte: &mut dyn FnMut() -> u8| u32::from(byte()) % ids;
-        match byte() % 16 {
+        match byte() % 18 {
             0 | 1 => {
                 let id = id(byte);
                 let fat = any_box(byte);
@@ -427,6 +644,18 @@ impl Op {
                 0 => Op::Rebuild,
                 b => Op::Maintain(u32::from(b) * 3),
             },
+            13 => {
+                let (origin, direction) = (any_point(byte), any_direction(byte));
+                Op::CastRay(
+                    Ray::new(origin, direction, any_length(byte)),
+                    any_layers(byte),
+                )
+            }
+            14 => {
+                let b = any_box(byte);
+                let motion = any_direction(byte);
+                Op::CastBox(b, motion, any_length(byte), any_layers(byte))
+            }
             _ => Op::Report,
         }
     }

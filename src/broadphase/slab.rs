@@ -1,0 +1,106 @@
+//! The slab test of a cast, conservative by proof: a box moving along a direction (a ray is
+//! a box of one point) against eight boxes at once.
+//!
+//! **What is decided.** A cast is a box `O = [lo, hi]` (for a ray, `lo = hi` = the origin)
+//! moving along `d` for `t` in `[0, max]`; it meets a box `P` at `t` when `O + t·d` and `P`
+//! share a point (closed boxes). On axis `a` that is `P.min ≤ hi + t·d` and
+//! `lo + t·d ≤ P.max`: for `d_a > 0`, `t ∈ [t0, t1]` with `t0 = (P.min − hi)/d_a` and
+//! `t1 = (P.max − lo)/d_a`; for `d_a < 0`, `t ∈ [t1, t0]`; for `d_a = 0`, every `t` when
+//! `P.min ≤ hi` and `lo ≤ P.max`, none otherwise. The cast meets `P` when the intersection of
+//! the three intervals with `[0, max]` is not empty, and its **entry** is the least `t` of
+//! that intersection. These are exact statements about the given `f32` values.
+//!
+//! **The computed interval contains the exact one.** Each bound is computed in `f64`, from
+//! `f32` inputs (exact in `f64`): `x = fl(P.min − hi)`, `r = fl(1/d_a)`, `t̃ = fl(x·r)`.
+//! Every operand is finite, and no result can overflow or be subnormal: a nonzero difference
+//! of two `f32` values is at least `2^-149` and at most `2^129` in magnitude, `|r|` lies in
+//! `[2^-128, 2^149]`, so `|t̃|` lies in `[2^-277, 2^278]`, far inside `f64`'s normal range
+//! (so FTZ and DAZ change nothing here; DAZ reads a subnormal `f32` input as zero, and the
+//! statements then hold for the values read). Each of the three roundings has a relative
+//! error of at most `u = 2^-53`, so `t̃ = t·(1 + δ)` with `|δ| ≤ (1 + u)^3 − 1 < 3.0001·u`,
+//! and `t̃ = 0` exactly when `t = 0`. The bounds are widened by `K = 2^-50 = 8u` of
+//! themselves: `lower(t̃) = fl(t̃ − |t̃|·K)` (the product is exact: a power of two, no
+//! underflow). For `t̃ > 0`, `lower(t̃) ≤ t̃·(1 − K)·(1 + u) < t̃·(1 − 7u)`, while
+//! `t = t̃/(1 + δ) > t̃·(1 − 3.0001u)`: so `lower(t̃) < t`. For `t̃ < 0` (all negative),
+//! `lower(t̃) ≤ t̃·(1 + K)·(1 − u) = t̃·(1 + 7u − 8u²) < t̃/(1 − 3.0001u) ≤ t`.
+//! `upper` is the mirror image, `upper(t̃) ≥ t`. The parallel case compares the inputs
+//! exactly. So each computed near bound is at most the exact one and each far bound at
+//! least the exact one, and the computed interval `[max(0, lower near), min(max, upper
+//! far)]` contains the exact one: **a box the exact cast meets within `max` is never
+//! missed, and the computed entry (rounded down to `f32`) is never beyond the exact
+//! entry.** (The computed interval may also accept a box the exact cast misses by a
+//! relative `2^-49` of the distance: a candidate, as every broadphase hit is.)
+//!
+//! An empty child slot (`+∞` below `−∞`) gives infinite or NaN bounds and is masked out by
+//! its reference, never by the arithmetic.
+
+use super::hierarchy::WIDTH;
+use glam::Vec3A;
+
+/// The relative widening of every computed bound: `2^-50`.
+const K: f64 = 1.0 / (1u64 << 50) as f64;
+
+/// A cast prepared once for its slab tests (see the [module docs](self)).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sweep {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// `1/d_a`, or 0 where `d_a = 0` (the axis is then tested by `parallel`).
+    inv: [f64; 3],
+    parallel: [bool; 3],
+}
+
+impl Sweep {
+    /// The box `[lo, hi]` moving along `d` (finite, `lo ≤ hi`: the caller checks).
+    pub(crate) fn new(lo: Vec3A, hi: Vec3A, d: Vec3A) -> Self {
+        let parallel = [0, 1, 2].map(|a| d[a] == 0.0);
+        Self {
+            lo: [0, 1, 2].map(|a| f64::from(lo[a])),
+            hi: [0, 1, 2].map(|a| f64::from(hi[a])),
+            inv: [0, 1, 2].map(|a| {
+                if parallel[a] {
+                    0.0
+                } else {
+                    1.0 / f64::from(d[a])
+                }
+            }),
+            parallel,
+        }
+    }
+
+    /// For eight boxes (their faces as columns), the entry bound of each (never beyond
+    /// the exact entry), and bit `k` set when box `k` may be met within `[0, max]` (always,
+    /// when the exact cast meets it).
+    #[inline(always)]
+    pub(crate) fn test(
+        &self,
+        min: &[[f32; WIDTH]; 3],
+        max: &[[f32; WIDTH]; 3],
+        limit: f64,
+    ) -> ([f64; WIDTH], u32) {
+        let mut enter = [0.0f64; WIDTH];
+        let mut exit = [limit; WIDTH];
+        let mut meets = [true; WIDTH];
+        for a in 0..3 {
+            let (lo, hi, inv) = (self.lo[a], self.hi[a], self.inv[a]);
+            if self.parallel[a] {
+                for k in 0..WIDTH {
+                    meets[k] &= f64::from(min[a][k]) <= hi && lo <= f64::from(max[a][k]);
+                }
+                continue;
+            }
+            for k in 0..WIDTH {
+                let t0 = (f64::from(min[a][k]) - hi) * inv;
+                let t1 = (f64::from(max[a][k]) - lo) * inv;
+                let (near, far) = if inv > 0.0 { (t0, t1) } else { (t1, t0) };
+                enter[k] = enter[k].max(near - near.abs() * K);
+                exit[k] = exit[k].min(far + far.abs() * K);
+            }
+        }
+        let mut bits = 0;
+        for k in 0..WIDTH {
+            bits |= u32::from(meets[k] && enter[k] <= exit[k]) << k;
+        }
+        (enter, bits)
+    }
+}
