@@ -6,7 +6,6 @@
 use super::slab::Sweep;
 use super::{BroadphaseError, DynamicTree, Layers};
 use crate::aabb::Aabb3;
-use crate::num::round_down;
 use glam::Vec3A;
 
 /// A ray: the points `origin + t·direction` for `t` in `[0, max]` (`max` in units of the
@@ -65,7 +64,7 @@ impl DynamicTree {
     /// which the exact ray enters the box, never beyond it (0 when the origin is in the box
     /// or on its boundary); every proxy the exact ray meets within its (clipped) length is
     /// called, once. Boxes are taken roughly nearest first (the children of each node by
-    /// entry), not in a global order. No heap allocation (unless the tree is deeper than 18
+    /// entry), not in a global order. No heap allocation (unless the tree is deeper than 9
     /// levels).
     ///
     /// Closest hit: return `CastControl::Clip(t)` with the exact hit `t` of the shape in
@@ -176,11 +175,11 @@ impl DynamicTree {
             return;
         }
         let proxies = &self.proxies;
-        let mut visit = |id: u32, entry: f64, limit: &mut f64| {
+        let mut visit = |id: u32, entry: f32, limit: &mut f64| {
             if !every && !proxies[id as usize].layers.interacts_with(layers) {
                 return true;
             }
-            match hit(id, round_down(entry)) {
+            match hit(id, entry) {
                 CastControl::Continue => true,
                 CastControl::Clip(t) if t.is_nan() => false,
                 CastControl::Clip(t) => {

@@ -13,6 +13,7 @@
 
 use super::slab::Sweep;
 use crate::aabb::Aabb3;
+use crate::num::round_down;
 use alloc::vec::Vec;
 use core::mem::take;
 use glam::Vec3A;
@@ -175,8 +176,9 @@ impl Child {
 }
 
 /// A descent's stack: on the caller's stack up to [`STACK_INLINE`] entries (a depth-first
-/// descent holds at most seven a level, so a tree of 18 levels), on the heap beyond, so
-/// that no tree, however deep its inserts made it, loses a hit.
+/// descent holds at most seven a level and one, so a tree of 9 levels, 134M proxies when
+/// built), on the heap beyond, so that no tree, however deep its inserts made it, loses a
+/// hit.
 pub(crate) struct Stack<T> {
     inline: [T; STACK_INLINE],
     len: usize,
@@ -184,7 +186,7 @@ pub(crate) struct Stack<T> {
 }
 
 /// The entries a [`Stack`] holds on the caller's stack.
-const STACK_INLINE: usize = 128;
+const STACK_INLINE: usize = 64;
 
 impl<T: Copy + Default> Stack<T> {
     #[inline(always)]
@@ -517,7 +519,7 @@ impl Hierarchy {
 
     /// Runs a cast ([`Sweep`]) through the hierarchy: calls `hit(id, entry, limit)` for
     /// every proxy whose box it may meet within `*limit` (every one the exact cast meets),
-    /// with a bound on its entry never beyond the exact entry; `hit` may lower `*limit`
+    /// with a bound on its entry never beyond the exact entry (rounded down to `f32`); `hit` may lower `*limit`
     /// (a clip), and returns false to stop the cast. The children of a node are taken
     /// nearest entry first, and any whose entry has passed the limit by then are skipped.
     /// Returns false when `hit` stopped it.
@@ -526,12 +528,13 @@ impl Hierarchy {
         &self,
         sweep: &Sweep,
         limit: &mut f64,
-        mut hit: impl FnMut(u32, f64, &mut f64) -> bool,
+        mut hit: impl FnMut(u32, f32, &mut f64) -> bool,
     ) -> bool {
-        let mut stack = Stack::<(f64, u32)>::new();
+        // Entries rounded down to `f32`: still never beyond the exact ones.
+        let mut stack = Stack::<(f32, u32)>::new();
         stack.push((0.0, 0));
         while let Some((entry, c)) = stack.pop() {
-            if entry > *limit {
+            if f64::from(entry) > *limit {
                 continue;
             }
             if c & LEAF != 0 {
@@ -564,7 +567,7 @@ impl Hierarchy {
                 if c & LEAF == 0 {
                     self.prefetch_node(c);
                 }
-                stack.push((enter[k], c));
+                stack.push((round_down(enter[k]), c));
             }
         }
         true

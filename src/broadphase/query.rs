@@ -11,7 +11,7 @@ impl DynamicTree {
     /// (closed boxes: touching counts) and whose layers interact with `layers`
     /// ([`Layers::interacts_with`]; [`Layers::ALL`] finds every proxy with a membership and
     /// a filter). Each proxy is found once, in an unspecified order. No heap allocation
-    /// (unless the tree is deeper than 18 levels, which inserts alone can make it).
+    /// (unless the tree is deeper than 9 levels, which inserts alone can make it).
     ///
     /// # Errors
     /// [`BroadphaseError::InvalidQuery`] for a box with a NaN face or a face below its

@@ -40,7 +40,9 @@ use glam::Vec3A;
 /// The relative widening of every computed bound: `2^-50`.
 const K: f64 = 1.0 / (1u64 << 50) as f64;
 
-/// A cast prepared once for its slab tests (see the [module docs](self)).
+/// A cast prepared once for its slab tests (see the [module docs](self)): per axis, which
+/// faces give the near and the far bound and the coordinates of the moving box they are
+/// measured from, or the parallel test.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Sweep {
     lo: [f64; 3],
@@ -48,6 +50,19 @@ pub(crate) struct Sweep {
     /// `1/d_a`, or 0 where `d_a = 0` (the axis is then tested by `parallel`).
     inv: [f64; 3],
     parallel: [bool; 3],
+}
+
+/// `max(a, b)` for non-NaN `a` (and `b` where it matters): one instruction, where
+/// `f64::max`'s NaN rule costs three.
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// `min(a, b)`, as [`larger`].
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
 }
 
 impl Sweep {
@@ -69,8 +84,9 @@ impl Sweep {
     }
 
     /// For eight boxes (their faces as columns), the entry bound of each (never beyond
-    /// the exact entry), and bit `k` set when box `k` may be met within `[0, max]` (always,
-    /// when the exact cast meets it).
+    /// the exact entry), and bit `k` set when box `k` may be met within `[0, limit]`
+    /// (always, when the exact cast meets it). A bound of an empty slot may be NaN: the
+    /// caller masks such slots.
     #[inline(always)]
     pub(crate) fn test(
         &self,
@@ -89,12 +105,18 @@ impl Sweep {
                 }
                 continue;
             }
+            // Moving up the axis, a box is entered at its min face (from `hi`) and left at
+            // its max face (from `lo`); moving down, the other way round.
+            let (near_face, near_from, far_face, far_from) = if inv > 0.0 {
+                (&min[a], hi, &max[a], lo)
+            } else {
+                (&max[a], lo, &min[a], hi)
+            };
             for k in 0..WIDTH {
-                let t0 = (f64::from(min[a][k]) - hi) * inv;
-                let t1 = (f64::from(max[a][k]) - lo) * inv;
-                let (near, far) = if inv > 0.0 { (t0, t1) } else { (t1, t0) };
-                enter[k] = enter[k].max(near - near.abs() * K);
-                exit[k] = exit[k].min(far + far.abs() * K);
+                let near = (f64::from(near_face[k]) - near_from) * inv;
+                let far = (f64::from(far_face[k]) - far_from) * inv;
+                enter[k] = larger(near - near.abs() * K, enter[k]);
+                exit[k] = smaller(far + far.abs() * K, exit[k]);
             }
         }
         let mut bits = 0;

@@ -521,6 +521,22 @@ impl Pipelines {
         [fa, fb, fc, fd, fr]
     }
 
+    /// C's tree, B's parry3d tree and D's obvhs tree (the pipelines must have run B and
+    /// D), and C's fat boxes by proxy (`n` bodies).
+    ///
+    /// # Panics
+    /// When B or D did not run.
+    pub fn trees(&self, n: usize) -> (&DynamicTree, &Bvh, &::obvhs::bvh2::Bvh2, Vec<Aabb3>) {
+        let b = self.b.as_ref().expect("B ran");
+        let d = self.d.as_ref().expect("D ran");
+        (
+            &self.c.tree,
+            &b.tree.bvh,
+            d.bvh(),
+            Aabb3x8::unpack(&self.c.fat, n),
+        )
+    }
+
     /// Checks C's last report against a sweep over its fat boxes, when the last check was
     /// the frame before: the pairs that began are the pairs that overlap now and did not
     /// then, and the pairs that ended the other way round. Returns the pairs missing from

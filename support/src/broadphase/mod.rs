@@ -3,6 +3,7 @@
 
 pub mod bvh;
 pub mod obvhs;
+pub mod queries;
 pub mod rapier;
 pub mod scene;
 

@@ -110,6 +110,11 @@ pub struct ObvhsTree {
 }
 
 impl ObvhsTree {
+    /// The tree.
+    pub fn bvh(&self) -> &Bvh2 {
+        &self.bvh
+    }
+
     /// A tree over `boxes` (proxy `i` has box `i`), built by PLOC.
     ///
     /// # Panics
