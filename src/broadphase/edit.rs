@@ -231,6 +231,26 @@ impl DynamicTree {
         true
     }
 
+    /// Gives proxy `id`, of any kind, the fat box `fat`: one proxy's [`DynamicTree::write`]
+    /// without a box array (a teleported door, a platform set in place). Its pairs begin and
+    /// end at the next report. A static proxy's move is a write in its own hierarchy: one
+    /// walk up from its slot, enlarging the boxes above it.
+    ///
+    /// # Errors
+    /// [`BroadphaseError::UnknownId`] when `id` is not in the tree and
+    /// [`BroadphaseError::InvalidBox`] for a NaN, infinite or inverted box (a `write` would
+    /// park the proxy; here nothing changes).
+    pub fn move_proxy(&mut self, id: u32, fat: Aabb3) -> Result<(), BroadphaseError> {
+        if !self.contains(id) {
+            return Err(BroadphaseError::UnknownId { id });
+        }
+        if !accepts(&fat) {
+            return Err(BroadphaseError::InvalidBox { id });
+        }
+        self.set(id, &fat, false);
+        Ok(())
+    }
+
     /// Makes proxy `id` of kind `kind`. Its pairs begin and end at the next report as the
     /// kinds admit them, as a move's do; a change between static and moving kinds moves
     /// the proxy to the other hierarchy (an insert's cost).

@@ -120,7 +120,7 @@ impl DynamicTree {
 
     /// Gives proxy `id` (in the tree) box `b`, or parks it when `b` is refused; with
     /// `refit`, the slots above a moving proxy wait for `Hierarchy::refit_marked`.
-    fn set(&mut self, id: u32, b: &Aabb3, refit: bool) {
+    pub(super) fn set(&mut self, id: u32, b: &Aabb3, refit: bool) {
         self.note(id);
         let at = self.at[id as usize];
         if !accepts(b) {
