@@ -69,8 +69,10 @@
 //! - `std` (default): run-time CPU detection. Without it the crate is `no_std` (with
 //!   `alloc`), takes its float functions from libm, and runs the backends the build's
 //!   target features guarantee (`-C target-cpu=…`), never fusing the batch lanes.
-//! - `rayon`: `Batch::transform_par`, bit-identical to [`Batch::transform`] on the same
-//!   backend.
+//! - `rayon`: `Batch::transform_par` and `Batch::update_par`, bit-identical to
+//!   [`Batch::transform`] and [`Batch::update`] on the same backend; the broadphase tree's
+//!   `update_par`, `report_par` and `cast_rays_par`, the same results in the same order on
+//!   any number of threads.
 //! - `serde`: `Serialize`/`Deserialize` on the boxes, the transform classes, [`Obb3`],
 //!   [`Sphere`], [`Capsule`], [`LargeRigid3`], [`Margin`], [`Method`], [`Rounding`],
 //!   [`Fit`] and [`Backend`].

@@ -865,3 +865,59 @@ fn a_level_with_moving_bodies_in_layers_agrees_with_brute_force() {
         check.ended
     );
 }
+
+/// Every proxy in the same layers, with no check of each pair (the tree's common layers):
+/// layers that meet themselves pair as `Layers::ALL` does, layers that do not (debris that
+/// ignores debris) never pair, until a proxy in other layers comes, which pairs as its
+/// layers say; and queries see the common layers' answer.
+#[test]
+fn proxies_all_in_one_layer_pair_as_that_layer_says() {
+    let mut r = StdRng::seed_from_u64(9);
+    let boxes: Vec<Aabb3> = (0..2000)
+        .map(|_| {
+            let c = Vec3A::new(r.random(), r.random(), r.random()) * 30.0;
+            Aabb3::new(c - 0.7, c + 0.7)
+        })
+        .collect();
+    let all = DynamicTree::from_boxes(&boxes).unwrap().overlapping_pairs();
+    assert!(all.len() > 500);
+    for (layers, pairs) in [
+        (Layers::new(1, 1), all.clone()),
+        (Layers::new(1, 2), Vec::new()),
+    ] {
+        let mut tree = DynamicTree::from_boxes_with(&boxes, |_| {
+            (bvkit::broadphase::BodyKind::Dynamic, layers)
+        })
+        .unwrap();
+        let mut report = Pairs::new();
+        tree.report(&mut report);
+        let mut begun = report.begun.clone();
+        begun.sort_unstable();
+        assert_eq!(begun, pairs, "{layers:?}");
+        assert_eq!(tree.overlapping_pairs(), pairs, "{layers:?}");
+        let everything = Aabb3::new(Vec3A::splat(-1e3), Vec3A::splat(1e3));
+        for (filter, seen) in [(Layers::new(2, 1), 2000), (Layers::new(1, 1), 0)] {
+            let mut n = 0;
+            tree.query(&everything, filter, |_| n += 1).unwrap();
+            let expected = if layers.interacts_with(filter) {
+                2000
+            } else {
+                0
+            };
+            assert_eq!(n, expected, "{layers:?} {filter:?} ({seen})");
+        }
+        // One proxy in other layers: it pairs as they say, the others as before.
+        tree.set_layers(0, Layers::ALL).unwrap();
+        tree.report(&mut report);
+        let with_zero: Vec<(u32, u32)> = all
+            .iter()
+            .copied()
+            .filter(|&(a, b)| {
+                pairs.contains(&(a, b))
+                    || (a == 0 && layers.interacts_with(Layers::ALL))
+                    || (b == 0 && layers.interacts_with(Layers::ALL))
+            })
+            .collect();
+        assert_eq!(tree.overlapping_pairs(), with_zero, "{layers:?}");
+    }
+}

@@ -27,7 +27,8 @@
 //! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
 //! leaves R out, `--check-all` checks every frame and `--no-check` none (for profiling), `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
 //! `--rebuild-frames F` tune C's upkeep; `--level M` adds M static boxes to C's tree at the bodies'
-//! density around the scene, `--floor M` a floor of M static tiles under it, and `--layers K`
+//! density around the scene, `--floor M` a floor of M static tiles under it, `--far M` M
+//! static boxes 3 km away, and `--layers K`
 //! puts C's proxy `i` in layer `i % K` alone (1: every proxy in one layer, through the filter).
 
 use bvkit_support::broadphase::{bvh, scene};
@@ -61,10 +62,11 @@ fn main() {
         partial: option("--partial").unwrap_or(0.0) as usize,
         rebuild_after: option("--rebuild-after").map(|x| x as f32),
         rebuild_frames: option("--rebuild-frames").map(|x| x as u32),
-        level: match (option("--level"), option("--floor")) {
-            (Some(m), _) => bvh::Level::Clutter(m as usize),
-            (None, Some(m)) => bvh::Level::Floor(m as usize),
-            (None, None) => bvh::Level::None,
+        level: match (option("--level"), option("--floor"), option("--far")) {
+            (Some(m), _, _) => bvh::Level::Clutter(m as usize),
+            (None, Some(m), _) => bvh::Level::Floor(m as usize),
+            (None, None, Some(m)) => bvh::Level::Far(m as usize),
+            (None, None, None) => bvh::Level::None,
         },
         layers: option("--layers").unwrap_or(0.0) as u32,
     };

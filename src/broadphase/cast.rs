@@ -170,8 +170,9 @@ impl DynamicTree {
         layers: Layers,
         mut hit: impl FnMut(u32, f32) -> CastControl,
     ) {
+        // While every proxy is in the common layers, one check answers for all.
         let every = self.unplain == 0;
-        if every && !layers.interacts_with(Layers::ALL) {
+        if every && !layers.interacts_with(self.common) {
             return;
         }
         let proxies = &self.proxies;

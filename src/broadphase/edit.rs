@@ -44,6 +44,7 @@ impl DynamicTree {
             .map_err(|_| BroadphaseError::OutOfMemory {
                 id: (len as u32).saturating_sub(1),
             })?;
+        let mut common = None;
         for i in 0..len {
             let (min, max) = fat.get(i);
             let b = Aabb3::new(min.into(), max.into());
@@ -57,8 +58,10 @@ impl DynamicTree {
             }
             items[kind.tier() as usize].push((i as u32, b));
             tree.tier_len[kind.tier() as usize] += 1;
-            tree.unplain += usize::from(!proxies[i].is_plain());
+            let common = *common.get_or_insert(layers);
+            tree.unplain += usize::from(!proxies[i].is_plain(common));
         }
+        tree.common = common.unwrap_or(Layers::ALL);
         let mut partners = Partners::default();
         partners
             .grow(len)
@@ -163,9 +166,9 @@ impl DynamicTree {
     fn set_proxy(&mut self, id: u32, proxy: Proxy) {
         let old = self.proxies[id as usize];
         self.tier_len[old.kind.tier() as usize] -= 1;
-        self.unplain -= usize::from(!old.is_plain());
+        self.unplain -= usize::from(!old.is_plain(self.common));
         self.tier_len[proxy.kind.tier() as usize] += 1;
-        self.unplain += usize::from(!proxy.is_plain());
+        self.unplain += usize::from(!proxy.is_plain(self.common));
         self.proxies[id as usize] = proxy;
     }
 
@@ -204,9 +207,13 @@ impl DynamicTree {
             return Err(BroadphaseError::Duplicate { id });
         }
         let proxy = Proxy { layers, kind };
+        if self.len == 0 {
+            // The first proxy of an empty tree sets the common layers.
+            self.common = layers;
+        }
         self.proxies[id as usize] = proxy;
         self.tier_len[kind.tier() as usize] += 1;
-        self.unplain += usize::from(!proxy.is_plain());
+        self.unplain += usize::from(!proxy.is_plain(self.common));
         self.note(id);
         self.restructured(id);
         self.place(id, &fat);
@@ -225,7 +232,7 @@ impl DynamicTree {
         self.take_out(id);
         let proxy = self.proxies[id as usize];
         self.tier_len[proxy.kind.tier() as usize] -= 1;
-        self.unplain -= usize::from(!proxy.is_plain());
+        self.unplain -= usize::from(!proxy.is_plain(self.common));
         self.at[id as usize] = Place::ABSENT;
         self.len -= 1;
         true

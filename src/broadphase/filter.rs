@@ -121,11 +121,11 @@ pub(super) struct Proxy {
 }
 
 impl Proxy {
-    /// True when the proxy's pairs take no check beyond their boxes: not kinematic, and in
-    /// every layer. (A static proxy's pairs are all with moving proxies, which are then
-    /// dynamic.)
+    /// True when the proxy's pairs take no check beyond their boxes where every proxy is
+    /// so: not kinematic, and in the tree's `common` layers. (A static proxy's pairs are
+    /// all with moving proxies, which are then dynamic.)
     #[inline(always)]
-    pub(super) fn is_plain(self) -> bool {
-        self.kind != BodyKind::Kinematic && self.layers == Layers::ALL
+    pub(super) fn is_plain(self, common: Layers) -> bool {
+        self.kind != BodyKind::Kinematic && self.layers == common
     }
 }

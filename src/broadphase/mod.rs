@@ -6,9 +6,10 @@
 //! engine hands it [`Moved::indices`](crate::Moved::indices) and the fat boxes, and
 //! [`DynamicTree::update`] runs the frame's three steps (each also callable alone):
 //! [`write`](DynamicTree::write) rewrites the moved proxies' boxes, enlarging the nodes
-//! above each up to the first that already holds it; [`maintain`](DynamicTree::maintain)
-//! builds a new hierarchy once enough has moved since the last build, a share in each
-//! call, and swaps it in when done;
+//! above each up to the first that already holds it (once half of the moving proxies or
+//! more move, marking their paths and refitting the marked nodes in one pass instead);
+//! [`maintain`](DynamicTree::maintain) builds a new hierarchy once enough has moved since
+//! the last build, a share in each call, and swaps it in when done;
 //! [`report`](DynamicTree::report) searches pairs only from the proxies changed since the
 //! last report:
 //!
@@ -59,6 +60,27 @@
 //! returns an error, and [`DynamicTree::write`] *parks* the proxy (it leaves the tree, its
 //! pairs end, and its id is listed in [`Pairs::refused`]) until a later update gives it a
 //! finite box. No such box ever reaches a node, so no later query or rebuild meets one.
+//!
+//! **Kinds and layers.** Each proxy is [`BodyKind::Dynamic`] (the default),
+//! [`BodyKind::Kinematic`] or [`BodyKind::Static`], and has [`Layers`] (32-bit memberships
+//! and filters; [`Layers::ALL`] by default), set at insert ([`DynamicTree::insert_with`],
+//! [`DynamicTree::from_boxes_with`]) and changeable ([`DynamicTree::set_kind`],
+//! [`DynamicTree::set_layers`]). A pair is reported only when its boxes overlap, one proxy
+//! is dynamic (or the tree's [`KindPairs`] admit the kinematic pair; two static proxies
+//! never pair), and each proxy's memberships meet the other's filters. The check is made
+//! in the search, before a pair is stored, and skipped while no proxy is kinematic or in
+//! other layers than all. A change of kind or layers begins and ends pairs at the next
+//! report exactly as a move does. Static proxies live in a hierarchy of their own, which no
+//! frame rebuilds or writes unless a static proxy moves: the report searches the moving
+//! hierarchy against itself and against the static one, from the changed proxies.
+//!
+//! **Queries and casts.** The same tree answers box and point queries
+//! ([`DynamicTree::query`], [`DynamicTree::query_point`]), ray casts and casts of a moving
+//! box ([`DynamicTree::cast_ray`], [`DynamicTree::cast_box`], and many rays at once,
+//! [`DynamicTree::cast_rays`]), over every kind, each with a layer filter and no heap
+//! allocation. A cast's callback goes on, clips the cast ([`CastControl::Clip`]: the
+//! closest hit) or stops it. Casts are conservative by proof: never a missed box, never
+//! an entry beyond the exact one (the proof is in `slab.rs`, beside the test).
 //!
 //! **Sleep.** Sleeping bodies need no call: they are not in the update's moved list, so
 //! their proxies stay as they are, their pairs last, and a moved proxy finds them as any
@@ -234,8 +256,11 @@ pub struct DynamicTree {
     /// The proxies, parked ones included: in all, and of each tier's kinds.
     len: usize,
     tier_len: [usize; 2],
-    /// The proxies that are not dynamic in every layer: while there are none, no pair
-    /// takes a check beyond its boxes.
+    /// The layers of the first proxy of an empty tree: most proxies' layers, as a rule.
+    common: Layers,
+    /// The proxies that are kinematic or not in the `common` layers: while there are none
+    /// (and the common layers interact with themselves), no pair takes a check beyond its
+    /// boxes, and no query a check of each proxy's layers.
     unplain: usize,
     /// True when a proxy's kind or layers (or the kind pairs) changed since the last report.
     refiltered: bool,
@@ -277,6 +302,7 @@ impl Default for DynamicTree {
             partners: Partners::default(),
             len: 0,
             tier_len: [0; 2],
+            common: Layers::ALL,
             unplain: 0,
             refiltered: false,
             kind_pairs: KindPairs::default(),

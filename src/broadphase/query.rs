@@ -26,8 +26,9 @@ impl DynamicTree {
             // A NaN face compares false too.
             return Err(BroadphaseError::InvalidQuery);
         }
+        // While every proxy is in the common layers, one check answers for all.
         let every = self.unplain == 0;
-        if every && !layers.interacts_with(Layers::ALL) {
+        if every && !layers.interacts_with(self.common) {
             return Ok(());
         }
         let proxies = &self.proxies;

@@ -126,7 +126,7 @@ impl DynamicTree {
             changes: &changes,
             partners: &self.partners,
             kind_pairs: self.kind_pairs,
-            filtered: self.unplain != 0,
+            filtered: self.unplain != 0 || !self.common.interacts_with(self.common),
             refiltered: self.refiltered,
         };
         let (begun, ended) = (&mut pairs.begun, &mut pairs.ended);

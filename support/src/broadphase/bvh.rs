@@ -103,6 +103,9 @@ pub enum Level {
     /// centred on the scene (1 km wide for 1M): the bodies meet as many static boxes as
     /// bodies, and most static boxes are far from every body.
     Clutter(usize),
+    /// `n` boxes as `Clutter`, in a cube 3 km away along x: the static proxies no body
+    /// meets, what a level's far parts cost.
+    Far(usize),
     /// A floor of `n` tiles (a square grid, 1 unit thick, with gaps of a tenth of a tile)
     /// under the scene, its top at the scene's bottom plus one unit: only the lowest
     /// bodies touch it.
@@ -118,8 +121,14 @@ impl Level {
         let mut r = rand::rngs::StdRng::seed_from_u64(0x1e7e1);
         match self {
             Level::None => Vec::new(),
-            Level::Clutter(m) => {
+            Level::Clutter(m) | Level::Far(m) => {
                 let side = 500.0 * (m as f32 / 1e6).cbrt();
+                let away = Vec3A::X
+                    * if matches!(self, Level::Far(_)) {
+                        3000.0
+                    } else {
+                        0.0
+                    };
                 (0..m)
                     .map(|_| {
                         let e = Vec3A::new(
@@ -132,7 +141,7 @@ impl Level {
                             r.random_range(-side..side),
                             r.random_range(-side..side),
                         );
-                        Aabb3::new(c - e, c + e)
+                        Aabb3::new(away + c - e, away + c + e)
                     })
                     .collect()
             }
