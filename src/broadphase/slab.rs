@@ -34,7 +34,6 @@
 //! An empty child slot (`+∞` below `−∞`) gives infinite or NaN bounds and is masked out by
 //! its reference, never by the arithmetic.
 
-use super::hierarchy::WIDTH;
 use glam::Vec3A;
 
 /// The relative widening of every computed bound: `2^-50`.
@@ -83,24 +82,24 @@ impl Sweep {
         }
     }
 
-    /// For eight boxes (their faces as columns), the entry bound of each (never beyond
+    /// For `W` boxes (their faces as columns: a node's eight), the entry bound of each (never beyond
     /// the exact entry), and bit `k` set when box `k` may be met within `[0, limit]`
     /// (always, when the exact cast meets it). A bound of an empty slot may be NaN: the
     /// caller masks such slots.
     #[inline(always)]
-    pub(crate) fn test(
+    pub(crate) fn test<const W: usize>(
         &self,
-        min: &[[f32; WIDTH]; 3],
-        max: &[[f32; WIDTH]; 3],
+        min: &[[f32; W]; 3],
+        max: &[[f32; W]; 3],
         limit: f64,
-    ) -> ([f64; WIDTH], u32) {
-        let mut enter = [0.0f64; WIDTH];
-        let mut exit = [limit; WIDTH];
-        let mut meets = [true; WIDTH];
+    ) -> ([f64; W], u32) {
+        let mut enter = [0.0f64; W];
+        let mut exit = [limit; W];
+        let mut meets = [true; W];
         for a in 0..3 {
             let (lo, hi, inv) = (self.lo[a], self.hi[a], self.inv[a]);
             if self.parallel[a] {
-                for k in 0..WIDTH {
+                for k in 0..W {
                     meets[k] &= f64::from(min[a][k]) <= hi && lo <= f64::from(max[a][k]);
                 }
                 continue;
@@ -112,7 +111,7 @@ impl Sweep {
             } else {
                 (&max[a], lo, &min[a], hi)
             };
-            for k in 0..WIDTH {
+            for k in 0..W {
                 let near = (f64::from(near_face[k]) - near_from) * inv;
                 let far = (f64::from(far_face[k]) - far_from) * inv;
                 enter[k] = larger(near - near.abs() * K, enter[k]);
@@ -120,7 +119,7 @@ impl Sweep {
             }
         }
         let mut bits = 0;
-        for k in 0..WIDTH {
+        for k in 0..W {
             bits |= u32::from(meets[k] && enter[k] <= exit[k]) << k;
         }
         (enter, bits)
