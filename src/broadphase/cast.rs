@@ -176,7 +176,7 @@ impl DynamicTree {
             return;
         }
         let proxies = &self.proxies;
-        let mut visit = |id: u32, entry: f32, limit: &mut f64| {
+        let mut visit = |id: u32, entry: f32, limit: &mut f32| {
             if !every && !proxies[id as usize].layers.interacts_with(layers) {
                 return true;
             }
@@ -184,19 +184,19 @@ impl DynamicTree {
                 CastControl::Continue => true,
                 CastControl::Clip(t) if t.is_nan() => false,
                 CastControl::Clip(t) => {
-                    *limit = limit.min(f64::from(t));
+                    *limit = limit.min(t);
                     // No entry is below 0.
                     *limit >= 0.0
                 }
                 CastControl::Stop => false,
             }
         };
-        let mut limit = f64::from(max);
+        let (mut limit, tame) = (max, !self.wild);
         crate::simd::plain(
             #[inline(always)]
             || {
-                if self.moving.cast(sweep, &mut limit, &mut visit) {
-                    self.fixed.cast(sweep, &mut limit, &mut visit);
+                if self.moving.cast(sweep, tame, &mut limit, &mut visit) {
+                    self.fixed.cast(sweep, tame, &mut limit, &mut visit);
                 }
             },
         );

@@ -2,7 +2,7 @@
 
 use super::{
     BodyKind, BroadphaseError, Change, DynamicTree, KindPairs, Layers, MAX_ID, MAX_NODES, Partners,
-    Place, Proxy, Tier, accepts,
+    Place, Proxy, Tier, accepts, tame,
 };
 use crate::aabb::Aabb3;
 use crate::layout::BoxSource;
@@ -56,6 +56,7 @@ impl DynamicTree {
             if !accepts(&b) {
                 return Err(BroadphaseError::InvalidBox { id: i as u32 });
             }
+            tree.wild |= !tame(&b);
             items[kind.tier() as usize].push((i as u32, b));
             tree.tier_len[kind.tier() as usize] += 1;
             let common = *common.get_or_insert(layers);
@@ -206,6 +207,7 @@ impl DynamicTree {
         if self.at[id as usize] != Place::ABSENT {
             return Err(BroadphaseError::Duplicate { id });
         }
+        self.wild |= !tame(&fat);
         let proxy = Proxy { layers, kind };
         if self.len == 0 {
             // The first proxy of an empty tree sets the common layers.

@@ -519,22 +519,62 @@ impl Hierarchy {
 
     /// Runs a cast ([`Sweep`]) through the hierarchy: calls `hit(id, entry, limit)` for
     /// every proxy whose box it may meet within `*limit` (every one the exact cast meets),
-    /// with a bound on its entry never beyond the exact entry (rounded down to `f32`); `hit` may lower `*limit`
+    /// with a bound on its entry never beyond the exact entry; `hit` may lower `*limit`
     /// (a clip), and returns false to stop the cast. The children of a node are taken
     /// nearest entry first, and any whose entry has passed the limit by then are skipped.
-    /// Returns false when `hit` stopped it.
+    /// Returns false when `hit` stopped it. `tame`: no box of the hierarchy has a coordinate
+    /// beyond [`F32_REACH`](super::slab::F32_REACH), so the `f32` test may take the cast.
     #[inline(always)]
     pub(crate) fn cast(
         &self,
         sweep: &Sweep,
-        limit: &mut f64,
-        mut hit: impl FnMut(u32, f32, &mut f64) -> bool,
+        tame: bool,
+        limit: &mut f32,
+        hit: impl FnMut(u32, f32, &mut f32) -> bool,
     ) -> bool {
-        // Entries rounded down to `f32`: still never beyond the exact ones.
+        // The tests inlined into the caller's target features (out of line, the lanes
+        // would run one at a time).
+        if sweep.fits_f32(tame) {
+            self.descend(
+                limit,
+                #[inline(always)]
+                |node, l| sweep.test_f32(&node.min, &node.max, l),
+                hit,
+            )
+        } else {
+            self.descend(
+                limit,
+                #[inline(always)]
+                |node, l| {
+                    // The entries of the children met rounded down to `f32`: still never
+                    // beyond the exact ones.
+                    let (enter, bits) = sweep.test(&node.min, &node.max, f64::from(l));
+                    let (mut down, mut met) = ([0.0; WIDTH], bits);
+                    while met != 0 {
+                        let k = met.trailing_zeros() as usize;
+                        met &= met - 1;
+                        down[k] = round_down(enter[k]);
+                    }
+                    (down, bits)
+                },
+                hit,
+            )
+        }
+    }
+
+    /// The descent of [`Hierarchy::cast`], with the slab test `test(node, limit)` (the
+    /// children's entry bounds and the bits of those met).
+    #[inline(always)]
+    fn descend(
+        &self,
+        limit: &mut f32,
+        test: impl Fn(&Node, f32) -> ([f32; WIDTH], u32),
+        mut hit: impl FnMut(u32, f32, &mut f32) -> bool,
+    ) -> bool {
         let mut stack = Stack::<(f32, u32)>::new();
         stack.push((0.0, 0));
         while let Some((entry, c)) = stack.pop() {
-            if f64::from(entry) > *limit {
+            if entry > *limit {
                 continue;
             }
             if c & LEAF != 0 {
@@ -544,7 +584,7 @@ impl Hierarchy {
                 continue;
             }
             let node = &self.nodes[c as usize];
-            let (enter, mut bits) = sweep.test(&node.min, &node.max, *limit);
+            let (enter, mut bits) = test(node, *limit);
             // The children met, by entry (insertion into at most eight).
             let (mut order, mut len) = ([0usize; WIDTH], 0);
             while bits != 0 {
@@ -567,7 +607,7 @@ impl Hierarchy {
                 if c & LEAF == 0 {
                     self.prefetch_node(c);
                 }
-                stack.push((round_down(enter[k]), c));
+                stack.push((enter[k], c));
             }
         }
         true

@@ -80,7 +80,8 @@
 //! [`DynamicTree::cast_rays`]), over every kind, each with a layer filter and no heap
 //! allocation. A cast's callback goes on, clips the cast ([`CastControl::Clip`]: the
 //! closest hit) or stops it. Casts are conservative by proof: never a missed box, never
-//! an entry beyond the exact one (the proof is in `slab.rs`, beside the test).
+//! an entry beyond the exact one, under FTZ and DAZ too (the proof is in `slab.rs`, beside
+//! the test).
 //!
 //! **Sleep.** Sleeping bodies need no call: they are not in the update's moved list, so
 //! their proxies stay as they are, their pairs last, and a moved proxy finds them as any
@@ -228,6 +229,12 @@ fn accepts(b: &Aabb3) -> bool {
     b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()
 }
 
+/// True when a box's coordinates are within the casts' `f32` reach.
+#[inline(always)]
+fn tame(b: &Aabb3) -> bool {
+    b.min.abs().max(b.max.abs()).max_element() <= slab::F32_REACH
+}
+
 /// A dynamic tree of fat boxes, fed by the moved set (see the [module docs](self)).
 #[derive(Clone, Debug)]
 pub struct DynamicTree {
@@ -264,6 +271,9 @@ pub struct DynamicTree {
     unplain: usize,
     /// True when a proxy's kind or layers (or the kind pairs) changed since the last report.
     refiltered: bool,
+    /// True once a box with a coordinate beyond the casts' `f32` reach entered the tree:
+    /// casts then take the `f64` test (`slab.rs`).
+    wild: bool,
     /// [`DynamicTree::set_kind_pairs`].
     kind_pairs: KindPairs,
     /// Per tier: the moves and inserts since its last build.
@@ -305,6 +315,7 @@ impl Default for DynamicTree {
             common: Layers::ALL,
             unplain: 0,
             refiltered: false,
+            wild: false,
             kind_pairs: KindPairs::default(),
             moves: [0; 2],
             rebuild_after: 16.0,

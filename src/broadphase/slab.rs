@@ -29,19 +29,45 @@
 //! far)]` contains the exact one: **a box the exact cast meets within `max` is never
 //! missed, and the computed entry (rounded down to `f32`) is never beyond the exact
 //! entry.** (The computed interval may also accept a box the exact cast misses by a
-//! relative `2^-49` of the distance: a candidate, as every broadphase hit is.)
+//! relative `2^-49` of the distance, or by a few `f32` steps in the `f32` form below: a
+//! candidate, as every broadphase hit is.)
+//!
+//! **The `f32` form.** Most casts take the same test in `f32` ([`Sweep::test_f32`]), whose
+//! bounds are widened by four `f32` steps where the `f64` ones are widened by `2^-50`. It
+//! applies where nothing can overflow, underflow harmfully or be flushed: every nonzero
+//! `|d_a|` in `[2^-20, 2^100]` and every coordinate of the moving box and of the tree's boxes
+//! at most `2^126` in magnitude (the tree keeps whether any box went beyond). Then
+//! `x = fl(P.min − hi)` cannot overflow (`|x| ≤ 2^127`) and is exact when subnormal (or, under
+//! FTZ, flushed from below `2^-126`, which moves `t` by less than `2^-106`); `r = fl(1/d_a)`
+//! is normal; `t̃ = fl(x·r)`, when its magnitude is at least `τ = 2^-100`, is normal and
+//! `t̃ = t·(1 + δ)` with `|δ| ≤ (1 + 2^-24)^3 − 1 < 3.0001·2^-24`. An `f32` step at `t̃` is at
+//! least `2^-24·|t̃|` (and four steps down from a power of two still `4·2^-24·|t̃|`), so four
+//! steps toward `−∞` give a lower bound of `t` and four toward `+∞` an upper bound. Where
+//! `|t̃| < τ`, the product may have underflowed (or been flushed), but then `|t| < 2^-99`
+//! and the bounds are `−τ` and `τ`. Where the product overflows to `±∞`, `|t|` is at least
+//! `MAX·(1 − 1.5·2^-24)`, and four steps from `±∞` land three steps inside `±MAX`
+//! (`MAX·(1 − 3·2^-24)`), no further out than `t`. DAZ reads a subnormal input as zero, and
+//! the statements hold for the values read. Every other cast takes the `f64` test.
 //!
 //! An empty child slot (`+∞` below `−∞`) gives infinite or NaN bounds and is masked out by
 //! its reference, never by the arithmetic.
 
+use crate::num::pow2;
 use glam::Vec3A;
 
 /// The relative widening of every computed bound: `2^-50`.
 const K: f64 = 1.0 / (1u64 << 50) as f64;
 
-/// A cast prepared once for its slab tests (see the [module docs](self)): per axis, which
-/// faces give the near and the far bound and the coordinates of the moving box they are
-/// measured from, or the parallel test.
+/// The largest coordinate magnitude the `f32` test takes: `2^126` (powers of two are exact
+/// in `f32`).
+pub(crate) const F32_REACH: f32 = pow2(126) as f32;
+/// `τ`: below it a computed `f32` bound may have underflowed.
+const TINY: f32 = pow2(-100) as f32;
+/// The nonzero direction components the `f32` test takes: `[2^-20, 2^100]`.
+const DIRECTION: core::ops::RangeInclusive<f32> = pow2(-20) as f32..=pow2(100) as f32;
+
+/// A cast prepared once for its slab tests (see the [module docs](self)): its box, its
+/// direction's reciprocals, its parallel axes, and whether the `f32` test takes it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Sweep {
     lo: [f64; 3],
@@ -49,6 +75,32 @@ pub(crate) struct Sweep {
     /// `1/d_a`, or 0 where `d_a = 0` (the axis is then tested by `parallel`).
     inv: [f64; 3],
     parallel: [bool; 3],
+    /// The same in `f32` (`fl(1/d_a)`), and whether the `f32` test takes the cast.
+    lo32: [f32; 3],
+    hi32: [f32; 3],
+    inv32: [f32; 3],
+    fits_f32: bool,
+}
+
+/// Four `f32` steps toward `−∞` (`−τ` near zero; `−∞` stays). Both steps are computed and
+/// one is picked, so that the lanes stay in vectors.
+#[inline(always)]
+fn below(t: f32) -> f32 {
+    let bits = t.to_bits();
+    let down = f32::from_bits(bits.wrapping_sub(4));
+    let out = f32::from_bits(bits.wrapping_add(4).min(0xff80_0000));
+    let stepped = if t > 0.0 { down } else { out };
+    if t.abs() < TINY { -TINY } else { stepped }
+}
+
+/// Four `f32` steps toward `+∞` (`τ` near zero; `+∞` stays).
+#[inline(always)]
+fn above(t: f32) -> f32 {
+    let bits = t.to_bits();
+    let out = f32::from_bits(bits.wrapping_add(4).min(0x7f80_0000));
+    let back = f32::from_bits(bits.wrapping_sub(4));
+    let stepped = if t > 0.0 { out } else { back };
+    if t.abs() < TINY { TINY } else { stepped }
 }
 
 /// `max(a, b)` for non-NaN `a` (and `b` where it matters): one instruction, where
@@ -68,7 +120,16 @@ impl Sweep {
     /// The box `[lo, hi]` moving along `d` (finite, `lo ≤ hi`: the caller checks).
     pub(crate) fn new(lo: Vec3A, hi: Vec3A, d: Vec3A) -> Self {
         let parallel = [0, 1, 2].map(|a| d[a] == 0.0);
+        let reach = F32_REACH;
+        let fits_f32 = (0..3).all(|a| {
+            let m = d[a].abs();
+            (parallel[a] || DIRECTION.contains(&m)) && lo[a].abs() <= reach && hi[a].abs() <= reach
+        });
         Self {
+            lo32: lo.to_array(),
+            hi32: hi.to_array(),
+            inv32: [0, 1, 2].map(|a| if parallel[a] { 0.0 } else { 1.0 / d[a] }),
+            fits_f32,
             lo: [0, 1, 2].map(|a| f64::from(lo[a])),
             hi: [0, 1, 2].map(|a| f64::from(hi[a])),
             inv: [0, 1, 2].map(|a| {
@@ -116,6 +177,51 @@ impl Sweep {
                 let far = (f64::from(far_face[k]) - far_from) * inv;
                 enter[k] = larger(near - near.abs() * K, enter[k]);
                 exit[k] = smaller(far + far.abs() * K, exit[k]);
+            }
+        }
+        let mut bits = 0;
+        for k in 0..W {
+            bits |= u32::from(meets[k] && enter[k] <= exit[k]) << k;
+        }
+        (enter, bits)
+    }
+    /// True when the `f32` test takes the cast against boxes whose coordinates are all at
+    /// most [`F32_REACH`] in magnitude (`tame`).
+    #[inline(always)]
+    pub(crate) fn fits_f32(&self, tame: bool) -> bool {
+        self.fits_f32 && tame
+    }
+
+    /// [`Sweep::test`] in `f32`, for a cast that [`Sweep::fits_f32`] (module docs): the same
+    /// guarantees, each bound four `f32` steps wide.
+    #[inline(always)]
+    pub(crate) fn test_f32<const W: usize>(
+        &self,
+        min: &[[f32; W]; 3],
+        max: &[[f32; W]; 3],
+        limit: f32,
+    ) -> ([f32; W], u32) {
+        let mut enter = [0.0f32; W];
+        let mut exit = [limit; W];
+        let mut meets = [true; W];
+        for a in 0..3 {
+            let (lo, hi, inv) = (self.lo32[a], self.hi32[a], self.inv32[a]);
+            if self.parallel[a] {
+                for k in 0..W {
+                    meets[k] &= min[a][k] <= hi && lo <= max[a][k];
+                }
+                continue;
+            }
+            let (near_face, near_from, far_face, far_from) = if inv > 0.0 {
+                (&min[a], hi, &max[a], lo)
+            } else {
+                (&max[a], lo, &min[a], hi)
+            };
+            for k in 0..W {
+                let near = below((near_face[k] - near_from) * inv);
+                let far = above((far_face[k] - far_from) * inv);
+                enter[k] = if near > enter[k] { near } else { enter[k] };
+                exit[k] = if far < exit[k] { far } else { exit[k] };
             }
         }
         let mut bits = 0;

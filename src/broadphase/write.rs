@@ -1,6 +1,6 @@
 //! A frame's first half: the moved proxies' new boxes written into their hierarchies.
 
-use super::{BroadphaseError, DynamicTree, Pairs, Place, REFIT_FROM, Tier, accepts};
+use super::{BroadphaseError, DynamicTree, Pairs, Place, REFIT_FROM, Tier, accepts, tame};
 use crate::aabb::Aabb3;
 use crate::layout::BoxSource;
 
@@ -132,6 +132,7 @@ impl DynamicTree {
             }
             return;
         }
+        self.wild |= !tame(b);
         let Some((tier, slot)) = at.slot() else {
             self.restructured(id);
             self.place(id, b);
