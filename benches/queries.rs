@@ -9,11 +9,13 @@
 //! throughput is rays (or boxes) per second.
 //!
 //! Before timing, the three trees' answers are compared: the same closest box (or a box
-//! entered within `1e-4` relative of it) and the same box counts.
+//! entered within `1e-4` relative of it), unless bvkit's is a near miss that its widened
+//! test lets through (checked exactly, and counted), and the same box counts.
 
 use bvkit_support::broadphase::queries::Trees;
 use bvkit_support::broadphase::scene::Scene;
 use bvkit_support::common::cpu;
+use bvkit_support::referee::{exact_entry, near_miss};
 
 use std::hint::black_box;
 
@@ -26,7 +28,7 @@ const RAYS: usize = 1024;
 
 /// Checks that the three trees answer alike, and prints what they found.
 fn agree(label: &str, trees: &Trees, rays: &[bvkit::broadphase::Ray], boxes: &[bvkit::Aabb3]) {
-    let mut hits = 0;
+    let (mut hits, mut grazes) = (0, 0);
     for ray in rays {
         let (a, b, c) = (
             trees.closest_bvkit(ray),
@@ -38,8 +40,17 @@ fn agree(label: &str, trees: &Trees, rays: &[bvkit::broadphase::Ray], boxes: &[b
             (Some((i, s)), Some((j, t))) => i == j || (s - t).abs() <= 1e-4 * s.abs().max(1.0),
             _ => false,
         };
+        // bvkit's closest may be a box the exact ray just misses (conservative by proof).
+        let grazed = a.is_some_and(|(id, t)| {
+            let b = &trees.fat[id as usize];
+            let (o, d) = (ray.origin, ray.direction);
+            exact_entry(o, o, d, ray.max, b).is_none()
+                && near_miss(o, o, d, ray.max, b)
+                && c.is_none_or(|(_, s)| t <= s)
+        });
+        grazes += usize::from(grazed);
         assert!(
-            near(a, b) && near(a, c),
+            grazed || (near(a, b) && near(a, c)),
             "{ray:?}: bvkit {a:?}, parry {b:?}, obvhs {c:?}"
         );
         hits += usize::from(a.is_some());
@@ -52,8 +63,9 @@ fn agree(label: &str, trees: &Trees, rays: &[bvkit::broadphase::Ray], boxes: &[b
         found += n;
     }
     println!(
-        "queries/{label}: {} boxes, CPU {}; of {RAYS} rays {hits} hit a box; {RAYS} boxes found \
-         {found}; obvhs's CwBvh conversion {:.1} ms (not timed below); {} threads",
+        "queries/{label}: {} boxes, CPU {}; of {RAYS} rays {hits} hit a box ({grazes} of them, \
+         for bvkit, a box the exact ray just misses); {RAYS} boxes found {found}; obvhs's \
+         CwBvh conversion {:.1} ms (not timed below); {} threads",
         trees.fat.len(),
         cpu(),
         trees.cwbvh_ms,

@@ -175,7 +175,7 @@ pub fn exact_entry(lo: Vec3A, hi: Vec3A, d: Vec3A, max: f32, p: &Aabb3) -> Optio
 /// True when the exact cast misses `p` only by an empty interval of `t` whose ends differ
 /// by at most `2^-19` of their sizes or by at most `2^-99`: what the slab test's widening
 /// (four `f32` steps, or `2^-50` in `f64`; `2^-100` near zero) may let through.
-fn near_miss(lo: Vec3A, hi: Vec3A, d: Vec3A, max: f32, p: &Aabb3) -> bool {
+pub fn near_miss(lo: Vec3A, hi: Vec3A, d: Vec3A, max: f32, p: &Aabb3) -> bool {
     let Some((enter, Some(exit))) = exact_interval(lo, hi, d, max, p) else {
         return false;
     };
