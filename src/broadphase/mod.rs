@@ -93,17 +93,19 @@ mod edit;
 mod error;
 mod filter;
 mod hierarchy;
+mod pairs;
 mod partners;
 mod query;
+mod ray;
 mod rebuild;
 mod report;
 mod slab;
 mod write;
 
-pub use cast::{CastControl, Ray};
 pub use error::BroadphaseError;
 pub use filter::{BodyKind, KindPairs, Layers};
-pub use report::Pairs;
+pub use pairs::Pairs;
+pub use ray::{CastControl, Ray};
 
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;

@@ -8,55 +8,10 @@
 
 use super::hierarchy::{self, Hierarchy, overlap};
 use super::partners::Partners;
-use super::{Change, DynamicTree, KindPairs, Place, Proxy, TRAVERSE_FROM, Tier};
+use super::{Change, DynamicTree, KindPairs, Pairs, Place, Proxy, TRAVERSE_FROM, Tier};
 use crate::aabb::Aabb3;
 use alloc::vec::Vec;
 use core::mem::take;
-
-/// What a frame of [`DynamicTree::update`] found. Each pair is `(smaller id, larger id)`,
-/// once; the order of the pairs is deterministic but unspecified. A pair is counted only
-/// where the proxies' kinds and layers admit it ([`BodyKind`](super::BodyKind),
-/// [`Layers`](super::Layers)).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Pairs {
-    /// The admitted pairs whose fat boxes overlap now, and did not (or were not admitted)
-    /// at the last report.
-    pub begun: Vec<(u32, u32)>,
-    /// The pairs reported at the last report whose fat boxes do not overlap now, or which
-    /// their kinds or layers no longer admit (filled only when made by
-    /// [`Pairs::with_ended`]).
-    pub ended: Vec<(u32, u32)>,
-    /// Moved proxies whose new box was refused (NaN, infinite or inverted) since the last
-    /// report, once per refusal; each was parked then (a later good box or a remove may
-    /// have changed that since).
-    pub refused: Vec<u32>,
-    ended_wanted: bool,
-}
-
-impl Pairs {
-    /// Begun pairs only.
-    #[must_use]
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Begun and ended pairs. The tree finds the ended ones in every report (it keeps each
-    /// proxy's partners, the proxies whose boxes overlapped its own at the last report, and
-    /// reads a changed proxy's), so asking for them costs only their list.
-    #[must_use]
-    pub fn with_ended() -> Self {
-        Self {
-            ended_wanted: true,
-            ..Self::default()
-        }
-    }
-
-    fn clear(&mut self) {
-        self.begun.clear();
-        self.ended.clear();
-        self.refused.clear();
-    }
-}
 
 impl DynamicTree {
     /// The pairs' half of a frame: `pairs` receives the pairs that began (and ended) since
