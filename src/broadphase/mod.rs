@@ -68,11 +68,11 @@
 //! [`DynamicTree::set_layers`]). A pair is reported only when its boxes overlap, one proxy
 //! is dynamic (or the tree's [`KindPairs`] admit the kinematic pair; two static proxies
 //! never pair), and each proxy's memberships meet the other's filters. The check is made
-//! in the search, before a pair is stored, and skipped while no proxy is kinematic or in
-//! other layers than all. A change of kind or layers begins and ends pairs at the next
-//! report exactly as a move does. Static proxies live in a hierarchy of their own, which no
-//! frame rebuilds or writes unless a static proxy moves: the report searches the moving
-//! hierarchy against itself and against the static one, from the changed proxies.
+//! in the search, before a pair is stored, and skipped while no proxy is kinematic and all
+//! share the layers of the first one. A change of kind or layers begins and ends pairs at
+//! the next report exactly as a move does. Static proxies live in a hierarchy of their own,
+//! which no frame rebuilds or writes unless a static proxy moves: the report searches the
+//! moving hierarchy against itself and against the static one, from the changed proxies.
 //!
 //! **Queries and casts.** The same tree answers box and point queries
 //! ([`DynamicTree::query`], [`DynamicTree::query_point`]), ray casts and casts of a moving
