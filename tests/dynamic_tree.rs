@@ -921,3 +921,41 @@ fn proxies_all_in_one_layer_pair_as_that_layer_says() {
         assert_eq!(tree.overlapping_pairs(), with_zero, "{layers:?}");
     }
 }
+
+/// A proxy removed and inserted again between two reports, with other layers or another
+/// kind: the report compares the pairs then and now, so a pair its old layers or kind did
+/// not admit and its new ones do begins, and the other way round ends.
+#[test]
+fn a_proxy_inserted_again_with_other_layers_or_kind_begins_and_ends_its_pairs() {
+    use bvkit::broadphase::BodyKind;
+    let b = Aabb3::new(Vec3A::ZERO, Vec3A::ONE);
+    let mut tree = DynamicTree::new();
+    tree.insert_with(7, b, BodyKind::Dynamic, Layers::new(1, 1))
+        .unwrap();
+    tree.insert_with(5, b, BodyKind::Dynamic, Layers::new(2, 2))
+        .unwrap();
+    let mut pairs = Pairs::with_ended();
+    tree.report(&mut pairs);
+    assert!(pairs.begun.is_empty());
+    // Back in layer 1: the pair begins.
+    assert!(tree.remove(5));
+    tree.insert_with(5, b, BodyKind::Dynamic, Layers::new(1, 1))
+        .unwrap();
+    tree.report(&mut pairs);
+    assert_eq!(pairs.begun, [(5, 7)]);
+    // Back as a static proxy beside a static one: the pair ends.
+    tree.set_kind(7, BodyKind::Static).unwrap();
+    tree.report(&mut pairs);
+    assert!(pairs.begun.is_empty() && pairs.ended.is_empty());
+    assert!(tree.remove(5));
+    tree.insert_with(5, b, BodyKind::Static, Layers::new(1, 1))
+        .unwrap();
+    tree.report(&mut pairs);
+    assert_eq!((pairs.begun.len(), pairs.ended.clone()), (0, vec![(5, 7)]));
+    // And dynamic again: it begins.
+    assert!(tree.remove(5));
+    tree.insert_with(5, b, BodyKind::Dynamic, Layers::new(1, 1))
+        .unwrap();
+    tree.report(&mut pairs);
+    assert_eq!((pairs.begun.clone(), pairs.ended.len()), (vec![(5, 7)], 0));
+}

@@ -136,9 +136,7 @@ impl DynamicTree {
     /// last report is then read from its partners.
     fn note_refiltered(&mut self, id: u32) {
         self.note(id);
-        let m = self.mark[id as usize] as usize;
-        self.pending[m - 1].tagged |= Change::REFILTERED;
-        self.refiltered = true;
+        self.tag_refiltered(id);
         // Its path must be marked for the report's traversal, as a write marks it.
         if let Some((tier, slot)) = self.at[id as usize].slot() {
             match tier {
@@ -146,6 +144,14 @@ impl DynamicTree {
                 Tier::Fixed => self.fixed.mark_changed(slot),
             }
         }
+    }
+
+    /// Tags `id`'s pending change as refiltered: its pairs at the last report are read from
+    /// its partners.
+    fn tag_refiltered(&mut self, id: u32) {
+        let m = self.mark[id as usize] as usize;
+        self.pending[m - 1].tagged |= Change::REFILTERED;
+        self.refiltered = true;
     }
 
     /// Takes placed proxy `id` out of its hierarchy.
@@ -217,6 +223,9 @@ impl DynamicTree {
         self.tier_len[kind.tier() as usize] += 1;
         self.unplain += usize::from(!proxy.is_plain(self.common));
         self.note(id);
+        // Removed and inserted again since the last report, it may come back with another
+        // kind or other layers: whether its pairs held then is read from its partners.
+        self.tag_refiltered(id);
         self.restructured(id);
         self.place(id, &fat);
         self.len += 1;
