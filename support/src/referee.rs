@@ -228,7 +228,7 @@ pub fn check_cast(
                 let floor = (0..8).fold(entry, |x, _| x.next_up());
                 let tiny = 2f32.powi(-99);
                 assert!(
-                    e.le(&Frac::of(floor)) || floor == f32::INFINITY || e.le(&Frac::of(tiny)),
+                    floor == f32::INFINITY || e.le(&Frac::of(floor)) || e.le(&Frac::of(tiny)),
                     "proxy {id}: entry {entry} far below the exact {}",
                     e.to_f64()
                 );
