@@ -79,6 +79,11 @@
 //! - `bytemuck`: `Pod` on the AoSoA blocks, [`Aabb2`], [`Translation2`], [`Rigid2`] and
 //!   [`Margin`]; `AnyBitPattern` (read from bytes) on the types holding a `Vec3A`, whose
 //!   fourth lane glam does not promise is initialised.
+//! - `bevy`: `From`/`Into` between [`Aabb3`], [`Aabb2`] and bevy_math 0.19's
+//!   `bounding::Aabb3d`, `Aabb2d`, and between [`Rigid3`], [`Rigid2`] and its `Isometry3d`,
+//!   `Isometry2d` (bevy 0.19 and avian 0.7 use glam 0.32: the floats are copied bit for bit).
+//!   A NaN or inverted bevy box converts as it is and is refused where bvkit refuses any bad
+//!   box.
 //!
 //! # The crate
 //!
@@ -151,6 +156,9 @@ extern crate std;
 
 mod aabb;
 mod batch;
+// From/Into with bevy_math's boxes and isometries (feature `bevy`).
+#[cfg(feature = "bevy")]
+mod bevy;
 // The broadphase's dynamic tree, fed by the moved set (issue 47).
 pub mod broadphase;
 mod engine;
