@@ -156,6 +156,10 @@ pub struct BvkitTimings {
     pub pairs: Duration,
     /// Steps timed.
     pub steps: u32,
+    /// Proxies whose enlarged box was written, over those steps.
+    pub moved: u64,
+    /// Pairs the tree reported begun, over those steps.
+    pub begun: u64,
 }
 
 impl BvkitTimings {
@@ -202,6 +206,8 @@ pub struct BvkitBroadPhase {
     held: HashMap<(u32, u32), (Entity, Entity)>,
     pairs: Pairs,
     moved: Vec<u32>,
+    /// Proxies inserted this step.
+    inserted: usize,
     parallel: bool,
     /// The stages' times.
     pub timings: BvkitTimings,
@@ -227,6 +233,7 @@ impl BvkitBroadPhase {
             held: HashMap::new(),
             pairs: Pairs::new(),
             moved: Vec::new(),
+            inserted: 0,
             parallel,
             timings: BvkitTimings::default(),
         }
@@ -279,6 +286,7 @@ impl BvkitBroadPhase {
         let _ = self
             .tree
             .insert_with(id, fat, kind_of(key, proxy), layers_of(proxy));
+        self.inserted += 1;
     }
 
     /// Frees `id`: out of the tree, its pairs ending at the next report.
@@ -432,6 +440,13 @@ fn collect_collision_pairs<H: CollisionHooks>(
     let broad = &mut *broad;
     sync_touched(broad, &trees, &keys, &aabbs);
     sync_moved(broad, &trees, &moved_proxies, &aabbs);
+    // A step that inserted a quarter of the tree or more loaded a scene: its proxies went in
+    // one by one, each down the greedy path, so the tree is built afresh at once rather than
+    // over the next steps' upkeep.
+    if broad.inserted >= 64 && broad.inserted * 4 >= broad.tree.len() {
+        broad.tree.rebuild();
+    }
+    broad.inserted = 0;
     let written = Instant::now();
 
     broad.tree.maintain();
@@ -527,6 +542,8 @@ fn collect_collision_pairs<H: CollisionHooks>(
     t.report += reported - written;
     t.pairs += end - reported;
     t.steps += 1;
+    t.moved += broad.moved.len() as u64;
+    t.begun += broad.pairs.begun.len() as u64;
     diagnostics.broad_phase += end - start;
 }
 

@@ -18,12 +18,17 @@ pub enum Broad {
     Bvkit { parallel: bool },
 }
 
-/// A headless app (no window, no render) on `threads` threads, one physics step per
-/// update.
+/// A headless app (no window, no render), its compute pool of `threads` threads (bevy's
+/// pools are made once per process: the first app's count holds for the others), one
+/// physics step per update.
 pub fn app(broad: Broad, threads: usize) -> App {
     let mut app = App::new();
+    // bevy's compute pool takes what its I/O and async pools leave, at least one thread:
+    // asked for `threads` threads it would get fewer, so its share is set.
+    let mut pools = TaskPoolOptions::with_num_threads(threads);
+    pools.compute.min_threads = threads;
     app.add_plugins(MinimalPlugins.set(TaskPoolPlugin {
-        task_pool_options: TaskPoolOptions::with_num_threads(threads),
+        task_pool_options: pools,
     }))
     .add_plugins(TransformPlugin);
     let physics = PhysicsPlugins::default().build();
@@ -113,7 +118,7 @@ pub fn level(world: &mut World, side: usize, debris: usize) -> Vec<Entity> {
                     Collider::cuboid(size, size, size),
                     Transform::from_xyz(
                         i as f32 * pitch - half + 0.3,
-                        4.0 + (n % 3) as f32,
+                        3.0 + 0.7 * (n % 3) as f32,
                         (k % per_row) as f32 * pitch - half + 0.3,
                     ),
                 ))
