@@ -54,6 +54,10 @@
 //! parked as [`DynamicTree::write`] parks a bad box: its pairs end, nothing panics, and it
 //! comes back with its next good box.
 
+mod spatial_query;
+
+pub use spatial_query::BvkitSpatialQuery;
+
 use core::marker::PhantomData;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
@@ -253,6 +257,11 @@ impl BvkitBroadPhase {
             .copied()
             .flatten()
             .map(|r| r.entity)
+    }
+
+    /// Tree proxy `id`'s collider and avian key.
+    fn record(&self, id: u32) -> Option<Record> {
+        self.records.get(id as usize).copied().flatten()
     }
 
     /// The tree proxy of `collider`, if it has one.

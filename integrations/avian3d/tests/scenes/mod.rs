@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use avian3d::prelude::*;
 use bevy::app::{TaskPoolOptions, TaskPoolPlugin};
+use bevy::ecs::system::SystemParamItem;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use bvkit_avian3d::BvkitBroadPhasePlugin;
@@ -22,6 +23,14 @@ pub enum Broad {
 /// pools are made once per process: the first app's count holds for the others), one
 /// physics step per update.
 pub fn app(broad: Broad, threads: usize) -> App {
+    app_with::<()>(broad, threads)
+}
+
+/// [`app`] with collision hooks `H`, in avian's narrow phase and in the broadphase.
+pub fn app_with<H: CollisionHooks + 'static>(broad: Broad, threads: usize) -> App
+where
+    for<'w, 's> SystemParamItem<'w, 's, H>: CollisionHooks,
+{
     let mut app = App::new();
     // bevy's compute pool takes what its I/O and async pools leave, at least one thread:
     // asked for `threads` threads it would get fewer, so its share is set.
@@ -31,13 +40,15 @@ pub fn app(broad: Broad, threads: usize) -> App {
         task_pool_options: pools,
     }))
     .add_plugins(TransformPlugin);
-    let physics = PhysicsPlugins::default().build();
+    let physics = PhysicsPlugins::default()
+        .with_collision_hooks::<H>()
+        .build();
     match broad {
         Broad::Avian => app.add_plugins(physics),
         Broad::Bvkit { parallel } => app.add_plugins(
             physics
-                .disable::<BvhBroadPhasePlugin>()
-                .add(BvkitBroadPhasePlugin::<()>::with_parallel(parallel)),
+                .disable::<BvhBroadPhasePlugin<H>>()
+                .add(BvkitBroadPhasePlugin::<H>::with_parallel(parallel)),
         ),
     };
     // One fixed step per update: the fixed clock and the update clock agree.
