@@ -125,7 +125,7 @@ impl Aabb3 {
 }
 
 impl Aabb2 {
-    /// The box through `xf`, any 2D [transform class](crate::Transform3), by `method`,
+    /// The box through `xf`, any 2D [transform class](crate::Transform2), by `method`,
     /// with the guarantee `rounding` gives.
     ///
     /// The bounds of [`Aabb3::transformed`] with `dims = 2` and the order `n` of

@@ -1,7 +1,7 @@
 //! [`Batch`] and its verbs, a thin public layer over the engine, a file each:
-//! [`Batch::transform`] (`transform`), [`Batch::update`] with the broadphase's fat boxes,
-//! moved set and pose sources (`update`, `moved`, `large`), and `transform_par` (`parallel`,
-//! feature `rayon`).
+//! [`Batch::transform`] (`transform`), [`Batch::update`] with the broadphase's fat boxes
+//! and pose sources (`update`, `large`; the moved set it fills is `fat/moved.rs`), and the
+//! `_par` entry points (`parallel`, feature `rayon`).
 
 mod large;
 #[cfg(feature = "rayon")]

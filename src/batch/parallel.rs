@@ -48,8 +48,8 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         self.src.get(self.start + i)
     }
-    // A window lies inside its source: the range below is always in bounds.
-    // Only AoS windows keep their route.
+    // Only AoS windows keep their route; `named` takes the window's range from the source
+    // with a checked `get`, `None` (the generic route) should it not lie inside.
     const ROUTE: Route = match S::ROUTE {
         Route::Aos => Route::Aos,
         _ => Route::Generic,
