@@ -114,8 +114,15 @@ where
 {
     fn build(&self, app: &mut App) {
         app.insert_resource(BvkitBroadPhase::new(self.parallel));
-        // Each change that avian makes to a proxy without marking it moved.
+        // Each change that avian makes to a proxy without marking it moved, and each that it
+        // marks moved: a collider spawned or re-enabled after this step's broadphase is
+        // marked moved, but avian clears the moved list at the end of the step.
         app.add_observer(touch::<Remove, ColliderTreeProxyKey>)
+            .add_observer(touch::<Insert, Collider>)
+            .add_observer(touch::<Insert, ColliderOf>)
+            .add_observer(touch::<Remove, ColliderOf>)
+            .add_observer(touch::<Remove, ColliderDisabled>)
+            .add_observer(touch::<Remove, Disabled>)
             .add_observer(touch::<Remove, Collider>)
             .add_observer(touch::<Add, ColliderDisabled>)
             .add_observer(touch::<Add, Disabled>)
@@ -565,6 +572,9 @@ fn sync_touched(
     aabbs: &Query<&EnlargedAabb, Allow<Disabled>>,
 ) {
     let mut touched = core::mem::take(&mut broad.touched);
+    // A collider is often noted twice (a spawn inserts `Collider` and `ColliderOf`).
+    touched.sort_unstable();
+    touched.dedup();
     broad.reassert.clear();
     for &entity in &touched {
         let now = keys
