@@ -1024,8 +1024,8 @@ impl Hierarchy {
 }
 
 /// What placing a proxy costs a build, against one centre of a split: a read of the proxy's
-/// box in the old hierarchy, scattered, and a node write. A rough weight: with it, the steps
-/// of a rebuild spread over 32 frames took 4–12 ms each at 1M proxies (AMD EPYC Zen 5).
+/// box in the old hierarchy, scattered, and a node write. A rough weight
+/// (`docs/decisions.md`, "A build's weight for placing a proxy").
 const PLACE_WORK: usize = 16;
 
 /// A node of a build being filled: its groups of centres, the largest split until every

@@ -134,10 +134,8 @@ pub(crate) trait Subset: Copy + core::fmt::Debug {
 
 /// True when `count` objects of `len` are dense enough that the lane loop runs them as a
 /// mask, in lanes: at least one object in sixteen. A sparser list runs an entry at a time,
-/// in one lane: spans of eight objects would seldom hold two of its objects. (Updating
-/// 100,000 AoSoA rigid bodies in a random list, AMD EPYC Zen 5: one lane and a mask broke
-/// even at 6.5% listed; at 12.5% the mask took 13.5 ns an object and one lane 16.3 ns, at
-/// 1% one lane 16 ns and the mask 18.6 ns.)
+/// in one lane: spans of eight objects would seldom hold two of its objects
+/// (`docs/decisions.md`, "When a list runs as a mask").
 #[inline(always)]
 pub(crate) fn dense(count: usize, len: usize) -> bool {
     count >= len / 16
@@ -321,12 +319,8 @@ pub(crate) trait Visit {
 /// The one walk of a scattered active set, in spans of `W::OBJECTS` objects: whole spans
 /// that follow each other are run together ([`Visit::whole`]), every other span on its own
 /// ([`Visit::part`]). A run of whole spans goes on over a mask's whole words a word at a
-/// time ([`SpanIter::whole_words`]): span by span, a mask of islands (runs of 200 to 2,000
-/// objects, half of them active) cost the update of 100,000 AoSoA rigid bodies 1.06x
-/// (naive) to 1.14x (abs-matrix, sign-select) on the lane loop (medians of 8 runs, AMD EPYC
-/// Zen 5); the AoS loop's walk, in spans of 64, stayed the same. Spans of one object are all scattered: an index list walked one entry
-/// at a time (building spans of several objects from a list cost the AoS loop 1.2-1.3x at
-/// 1% and 10% active, AMD EPYC Zen 5; 1.4x on an Intel Xeon).
+/// time ([`SpanIter::whole_words`]). Spans of one object are all scattered: an index list
+/// is walked one entry at a time (`docs/decisions.md`, "The walk of an active set").
 #[inline(always)]
 pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl Visit) {
     let mut ahead = set.lookahead();
@@ -390,9 +384,8 @@ const AHEAD: usize = 16;
 
 /// How far into the next span a run of whole spans requests its active objects before it
 /// runs (those at even offsets, and those that follow an inactive one: about a line each
-/// of 32-byte objects), and no further than the run is long. On a 1M-body update, half of
-/// them asleep in islands of 256, the masked AoS update took 3.2-3.3 ns a body with it,
-/// 3.4-3.7 with 16 and 3.7-4.1 without (AMD EPYC Zen 5).
+/// of 32-byte objects), and no further than the run is long (`docs/decisions.md`, "How
+/// far a run of whole spans requests ahead").
 const RUN_AHEAD: usize = 64;
 
 /// The scattered objects a run will visit next, whose memory it requests [`AHEAD`]

@@ -21,9 +21,8 @@ use crate::simd::{self, Backend, BoxGroup, GroupJob};
 use crate::transform::{Maps, NamedPoses, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of a span of a mask's walk ([`active::walk`]): a mask word's worth, whole
-/// words that follow each other run several boxes per vector. (Spans of eight cost a
-/// masked update 1.1x at 1% and 10% active, AMD EPYC Zen 5.) An index list is walked one
-/// entry at a time.
+/// words that follow each other run several boxes per vector (`docs/decisions.md`, "The
+/// AoS loop's spans of 64"). An index list is walked one entry at a time.
 const SPAN: usize = 64;
 
 /// The validity test of the AoS loop is taken once per this many objects.
@@ -269,10 +268,8 @@ impl AosCall<'_> {
 }
 
 /// The objects [`AosCall::swept`] computes at each pose in one run: two chunks, its two
-/// scratch blocks 8 KiB on the stack. Blocks of 64 to 1024 objects were tried. Larger
-/// blocks ran batches in the caches a little faster (fewer runs to start), but past them
-/// each run read its one or two streams on its own: with blocks of 256, an update of a
-/// million objects took 12.0 ns each, against 8.7 at 128 (AMD EPYC Zen 5).
+/// scratch blocks 8 KiB on the stack: past the caches, larger blocks read their streams
+/// one run at a time (`docs/decisions.md`, "The swept update's blocks").
 const SWEPT_BLOCK: usize = 2 * CHUNK;
 
 impl AosCall<'_> {
@@ -438,12 +435,9 @@ fn union(a: &Aabb3, b: &Aabb3) -> Aabb3 {
 }
 
 /// `$walk(run, poses, tight, $set)` once per method and pose kind, each specialised to its
-/// kernel, with groups `$groups` of `$w` boxes (the naive baseline too: one box per
-/// `Vec3A` would have saved the library's release build 3 s and run it 1.7x slower, a cost
-/// that the trade report would then have charged to the method). The rounding is a branch
-/// the loop does not change: specialising it too doubled the library's build (20.6 to
-/// 37.6 s in release) for no measurable speed (`speed/1K` and `speed/4M` AoS rows within 5%,
-/// AMD EPYC Zen 5).
+/// kernel, with groups `$groups` of `$w` boxes (the naive baseline too, so that the trade
+/// report charges the method and not its loop). The rounding is a branch the loop does not
+/// change (`docs/decisions.md`, "The AoS loops' kernels and rounding").
 macro_rules! each_kernel {
     ($run:expr, $maps:expr, $w:ident, $groups:ty, $walk:ident $(, $set:expr)?) => {{
         specialise!($run.method, |method| {

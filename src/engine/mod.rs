@@ -415,10 +415,9 @@ where
 
     /// Its objects requested first; then the span runs in lanes, its inactive lanes (and
     /// those past the last object) computed and ignored, or a list's entry in one lane of
-    /// the same arithmetic. (Running a lone active object in one lane too compiled a third
-    /// kernel into every walk: one `update` on AoSoA blocks rebuilt in 3.9-4.5 s with it and
-    /// 3.1 s without, a `Swept` one in 6.7 and 5.1 s; masked updates ran within 3% either
-    /// way. AMD EPYC Zen 5.)
+    /// the same arithmetic. A lone active object of a mask runs in lanes too: in one lane
+    /// it would compile a third kernel into every walk (`docs/decisions.md`, "No one-lane
+    /// kernel in a mask's walk").
     #[inline(always)]
     fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
         ahead.advance(span.lanes.count_ones() as usize);
@@ -453,14 +452,8 @@ struct Scattered<const N: usize, B, P, S, A> {
 impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Job for Every<N, B, P, S> {
     /// One loop per method, so that each is specialised to its kernel; the rounding is a
     /// loop-invariant branch. The scalar reference (lanes of one) has one loop, the method
-    /// a run-time value: it is there to be checked against, not to be fast. Its three
-    /// copies were 42K of the library's 539K lines of optimised IR (the AoS classes run
-    /// it on the scalar backend), and 2K of an AoSoA call site's 37K; the scalar backend's
-    /// in-cache AoSoA transform went from 29.5 to 41-43 ns a box naive, 15.6 to 15.8-23
-    /// ns abs-matrix (AMD EPYC Zen 5). Specialising it too grew the `speed` bench binary by 15%;
-    /// it sped most in-cache SoA rows by up to 24% but made one rigid row 3.3x slower,
-    /// where LLVM built the quaternion lanes' arithmetic from 128-bit pieces through the
-    /// stack (measured on an Intel Xeon; the issue 23 notes have the tables).
+    /// a run-time value: it is there to be checked against, not to be fast
+    /// (`docs/decisions.md`, "One loop for the scalar reference").
     #[inline(always)]
     fn run<L: LaneArray>(self) {
         let mut run = self.0.trim();
@@ -540,8 +533,8 @@ where
         }
         // The tail. A sink that takes every object (a transform's) runs it one object at a
         // time: its loop has no other partial span, and a one-lane kernel is less code than
-        // a partial span's loads and stores (a SoA `transform` call site rebuilt in 0.85-1.05 s
-        // so, and in 1.05-1.33 s with a partial span, AMD EPYC Zen 5). Any other runs it as one partial span, as
+        // a partial span's loads and stores (`docs/decisions.md`, "A transform's tail, one
+        // object at a time"). Any other runs it as one partial span, as
         // its walks run every other span, so that they compile no one-lane kernel. (A lane
         // type of one object, the scalar reference's, has no tail.)
         if S::EVERY {

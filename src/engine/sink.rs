@@ -77,11 +77,9 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
             self.out.store(i, count, min, max);
         }
         // The rare lanes that do not stand are recomputed from the source data. The branch
-        // is marked cold, so that the registers go to the common path (an in-cache SoA
-        // rigid batch ran up to 1.15x slower without the hint); and nothing here takes
-        // `&mut self` out of line, so the layout descriptors stay in registers (calling
-        // out of line with them cost an in-cache AoSoA translation batch 1.1-1.35x; both
-        // measured on an Intel Xeon).
+        // is marked cold, so that the registers go to the common path; and nothing here
+        // takes `&mut self` out of line, so the layout descriptors stay in registers
+        // (`docs/decisions.md`, "The cold redo of lanes that do not stand").
         if redo.any_nonzero() {
             core::hint::cold_path();
             for k in 0..count {
@@ -148,9 +146,9 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
             return;
         }
         // Boxes left a whole span of active boxes that all stand: the span is stored here,
-        // the boxes that stay with their own bits. Out of line with the rarer cases, it
-        // was most of an update where many bodies move (an AoSoA update of 1M bodies, one
-        // in ten leaving: 4.8 against 3.7 ns a body, AMD EPYC Zen 5).
+        // the boxes that stay with their own bits; out of line with the rarer cases, it
+        // was most of an update where many bodies move (`docs/decisions.md`, "A whole
+        // span's store in line").
         if count == L::WIDTH && lanes == u64::MAX >> (64 - L::WIDTH) && !redo.any_nonzero() {
             self.blend(i, count, -outside, tight, [fat_min, fat_max]);
             self.moved.record(i, u64::from(outside.nonzero_mask()));
@@ -311,10 +309,9 @@ impl Fat<'_, &mut [Aabb3]> {
     /// box left: it stores the group's fat boxes with the grown boxes picked in
     /// ([`BoxGroup::pick`]), so the others keep their bits. A branch per group mispredicts
     /// on the groups a walk moves at random, and past the caches each miss also discards
-    /// the loads issued behind it: with one body in ten leaving, that branch took an
-    /// update of 1M bodies from 3.4 to 6.3 ns a body, against 4.1 with the two passes,
-    /// whose visit mispredicts about once per 64 objects (AMD EPYC Zen 5; in the caches
-    /// the two ran alike). The objects are recorded once per 64.
+    /// the loads issued behind it; the two passes' visit mispredicts about once per 64
+    /// objects (`docs/decisions.md`, "Two passes over the fat boxes"). The objects are
+    /// recorded once per 64.
     #[inline(always)]
     fn take<const W: usize, P: BoxGroup<W>>(&mut self, first: usize, tight: &[Aabb3]) {
         debug_assert_eq!(first % 64, 0, "a chunk starts on a word of the moved set");

@@ -166,11 +166,9 @@ pub(crate) fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
         // `wide` fuses exactly where FMA is enabled at compile time (on x86-64): without
         // it, its lanes are the baseline's too, and one copy of the loop serves both. The
         // plain arrays, whose code LLVM's vectoriser builds, then are not compiled as a
-        // loop at all: that copy was more than half of a call site's release rebuild (one
-        // `transform` and one `update` on AoSoA blocks, 32.3-32.9 s with it and 14.0-14.3 s
-        // without; a `Swept` update, 86-91 s and 29-32 s; AMD EPYC Zen 3, 2 cores). Both
-        // are SSE2 code on the same vectors: the batch bench's baseline rows stayed within
-        // the VM's noise.
+        // loop at all: that copy was more than half of a call site's release rebuild, and
+        // both are SSE2 code on the same vectors (`docs/decisions.md`, "One baseline loop
+        // without FMA").
         #[cfg(all(target_arch = "x86_64", not(target_feature = "fma")))]
         (Backend::Baseline | Backend::Wide, _) => job.run::<wide::f32x8>(),
         #[cfg(not(all(target_arch = "x86_64", not(target_feature = "fma"))))]
