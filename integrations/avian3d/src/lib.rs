@@ -59,7 +59,7 @@ mod spatial_query;
 pub use spatial_query::BvkitSpatialQuery;
 
 use core::marker::PhantomData;
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use avian3d::collider_tree::{
@@ -213,8 +213,9 @@ pub struct BvkitBroadPhase {
     /// The proxies of the touched colliders, whose pairs are asserted again after the
     /// report: avian may have removed their edges while their boxes still overlap.
     reassert: Vec<u32>,
-    /// Overlapping pairs a joint or a hook refused, with their colliders then.
-    held: HashMap<(u32, u32), (Entity, Entity)>,
+    /// Overlapping pairs a joint or a hook refused, with their colliders then; ordered, so
+    /// that the edges they add come in the same order in every run.
+    held: BTreeMap<(u32, u32), (Entity, Entity)>,
     pairs: Pairs,
     moved: Vec<u32>,
     /// Proxies inserted this step.
@@ -241,7 +242,7 @@ impl BvkitBroadPhase {
             by_entity: EntityHashMap::default(),
             touched: Vec::new(),
             reassert: Vec::new(),
-            held: HashMap::new(),
+            held: BTreeMap::new(),
             pairs: Pairs::new(),
             moved: Vec::new(),
             inserted: 0,
