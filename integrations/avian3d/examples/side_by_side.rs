@@ -84,8 +84,9 @@ struct Measured {
     /// The edges in the contact graph at the end.
     edges: usize,
     colliders: usize,
-    /// bvkit's stages per step, in milliseconds: mirror and writes, report, pairs.
-    split: Option<(f64, f64, f64)>,
+    /// bvkit's stages per step, in milliseconds (mirror and writes, report, pairs), and its
+    /// proxies moved and pairs begun per step.
+    split: Option<(f64, f64, f64, u64, u64)>,
     /// bvkit's copies of the moved boxes at the edge (glam 0.32 to 0.33), per step, in
     /// milliseconds, timed apart.
     copies: Option<f64>,
@@ -151,12 +152,14 @@ fn measure(
     };
     let split = app.world().get_resource::<BvkitBroadPhase>().map(|b| {
         let t = b.timings;
-        eprintln!(
-            "  {scene:?} {n}: {} moved, {} begun a step",
-            t.moved / u64::from(t.steps.max(1)),
-            t.begun / u64::from(t.steps.max(1))
-        );
-        (ms(t.write), ms(t.report), ms(t.pairs))
+        let per_step = |n: u64| n / u64::from(t.steps.max(1));
+        (
+            ms(t.write),
+            ms(t.report),
+            ms(t.pairs),
+            per_step(t.moved),
+            per_step(t.begun),
+        )
     });
     let is_bvkit = split.is_some();
     let copies = is_bvkit.then(|| {
@@ -251,7 +254,9 @@ fn rows(threads: usize, quick: bool, only: Option<(Scene, usize)>) {
                 });
                 let split = m
                     .split
-                    .map_or(String::new(), |(w, r, p)| format!("{w:.2}, {r:.2}, {p:.2}"));
+                    .map_or(" | | ".to_string(), |(w, r, p, moved, begun)| {
+                        format!("{w:.2}, {r:.2}, {p:.2} | {moved} | {begun}")
+                    });
                 let copies = m.copies.map_or(String::new(), |c| format!("{c:.3}"));
                 println!(
                     "| {scene:?} | {} | {label} | {} | {:.2} | {:.2} | {:.2} | {b:.2}× | {s:.2}× | {} | {split} | {copies} |",
@@ -309,9 +314,9 @@ fn main() {
     );
     println!();
     println!(
-        "| scene | colliders | threads | broadphase | broadphase ms | of it, pair search ms | step ms | broadphase / avian's | step / avian's | edges | bvkit: mirror, report, pairs ms | copies at the edge ms |"
+        "| scene | colliders | threads | broadphase | broadphase ms | of it, pair search ms | step ms | broadphase / avian's | step / avian's | edges | bvkit: mirror, report, pairs ms | moved a step | begun a step | copies at the edge ms |"
     );
-    println!("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---:|");
+    println!("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|");
     // bevy's task pools are made once per process: a process per thread count.
     let exe = std::env::current_exe().expect("the example's own path");
     for threads in [1, cores] {
