@@ -26,9 +26,15 @@
 //! dense id of its own:
 //! - a proxy in [`MovedProxies`] is inserted (a new or re-keyed collider) or takes its new
 //!   enlarged box, in one [`DynamicTree::write`] a step;
-//! - a collider that is despawned, disabled, loses its collider, or changes its layers or
-//!   its sensor marker is noted by an observer and compared with avian's proxy at the next
-//!   step (removed, or given its new layers and kind).
+//! - a collider that is spawned, despawned, disabled or enabled again, re-parented, loses
+//!   or replaces its collider, or changes its layers, its sensor marker or its body's kind
+//!   is noted by an observer and compared with avian's proxy at the next step (inserted,
+//!   removed, or given its new layers and kind), whatever avian's moved list says: avian
+//!   clears that list at the end of each step, so a collider spawned after the broadphase
+//!   would otherwise be lost.
+//!
+//! A step that inserts a quarter of the tree or more (a scene spawned) rebuilds the tree at
+//! once rather than over the next steps' upkeep.
 //!
 //! Then one [`DynamicTree::report`] gives the pairs that began. Each is checked as avian's
 //! own broadphase checks a pair (the same body, an existing contact edge, a joint that
@@ -36,7 +42,11 @@
 //! contact events from either proxy, contacts modified when either asks, and no constraints
 //! for a sensor or a disabled body. A pair refused by a joint or a hook is held and asked
 //! again whenever one of its proxies moves, as avian asks again; pairs that end are left to
-//! avian's narrow phase, which removes an edge once the enlarged boxes part.
+//! avian's narrow phase, which removes an edge once the enlarged boxes part. Where avian
+//! removes a collider's edges while its boxes still overlap (a sensor marker added or
+//! removed, a `RigidBody` inserted), the tree is queried for that collider's pairs again.
+//!
+//! [`BvkitSpatialQuery`] answers avian's spatial-query verbs from the same tree.
 //!
 //! # Kinds
 //!
