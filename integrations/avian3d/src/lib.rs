@@ -521,7 +521,25 @@ fn collect_collision_pairs<H: CollisionHooks>(
             Verdict::Drop => false,
         }
     });
-    for &(a, b) in &pairs.begun {
+    // The touched proxies' overlapping pairs, whose edges avian may have removed, are
+    // settled with the begun ones.
+    reassert.sort_unstable();
+    reassert.dedup();
+    let mut found = Vec::new();
+    for &id in reassert.iter() {
+        let (Some(kind), Some(layers), Some(fat)) = (tree.kind(id), tree.layers(id), tree.get(id))
+        else {
+            continue;
+        };
+        let _ = tree.query(&fat, layers, |other| {
+            let static_pair =
+                kind == BodyKind::Static && tree.kind(other) == Some(BodyKind::Static);
+            if other != id && !static_pair {
+                found.push((id.min(other), id.max(other)));
+            }
+        });
+    }
+    for &(a, b) in pairs.begun.iter().chain(&found) {
         let Some((r1, p1, r2, p2)) = proxies(a, b) else {
             continue;
         };
@@ -531,36 +549,6 @@ fn collect_collision_pairs<H: CollisionHooks>(
                 held.insert((a, b), (r1.entity, r2.entity));
             }
             Verdict::Drop => {}
-        }
-    }
-    // The touched proxies' overlapping pairs, whose edges avian may have removed.
-    reassert.sort_unstable();
-    reassert.dedup();
-    let mut found = Vec::new();
-    for &id in reassert.iter() {
-        let (Some(kind), Some(layers), Some(fat)) = (tree.kind(id), tree.layers(id), tree.get(id))
-        else {
-            continue;
-        };
-        found.clear();
-        let _ = tree.query(&fat, layers, |other| {
-            let static_pair =
-                kind == BodyKind::Static && tree.kind(other) == Some(BodyKind::Static);
-            if other != id && !static_pair {
-                found.push((id.min(other), id.max(other)));
-            }
-        });
-        for &(a, b) in &found {
-            let Some((r1, p1, r2, p2)) = proxies(a, b) else {
-                continue;
-            };
-            match judge(p1, p2, &contact_graph, &joint_graph, &hooks, &mut commands) {
-                Verdict::Add => add_edge(&mut contact_graph, p1, p2),
-                Verdict::Hold => {
-                    held.insert((a, b), (r1.entity, r2.entity));
-                }
-                Verdict::Drop => {}
-            }
         }
     }
     let end = Instant::now();
