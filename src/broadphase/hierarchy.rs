@@ -122,7 +122,7 @@ impl Node {
     /// Bit `k` set when child `k`'s box overlaps the query's (closed boxes): six 8-lane
     /// compares (twelve SSE compares on a baseline x86-64 build).
     #[inline(always)]
-    fn overlaps(&self, q: &Query) -> u32 {
+    fn overlaps(&self, q: &QueryBox) -> u32 {
         let mut hit = f32x8::splat(0.0).simd_le(f32x8::splat(0.0));
         for a in 0..3 {
             hit &= q.min[a].simd_le(f32x8::new(self.max[a]));
@@ -137,12 +137,12 @@ impl Node {
 }
 
 /// A query box, each face splat across the lanes.
-pub(crate) struct Query {
+pub(crate) struct QueryBox {
     min: [f32x8; 3],
     max: [f32x8; 3],
 }
 
-impl Query {
+impl QueryBox {
     #[inline(always)]
     fn new(b: &Aabb3) -> Self {
         Self {
@@ -498,7 +498,7 @@ impl Hierarchy {
     /// (no heap allocation unless the tree is deeper than a [`Stack`] holds inline).
     #[inline(always)]
     pub(crate) fn query_one(&self, q: &Aabb3, mut hit: impl FnMut(u32, &Aabb3)) {
-        let splat = Query::new(q);
+        let splat = QueryBox::new(q);
         let mut stack = Stack::<u32>::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
@@ -632,7 +632,7 @@ impl Hierarchy {
         );
         let mut splat = [const { None }; WIDTH];
         for (s, q) in splat.iter_mut().zip(qs) {
-            *s = Some(Query::new(q));
+            *s = Some(QueryBox::new(q));
         }
         stack.clear();
         stack.push((1u64 << qs.len()) - 1);
@@ -744,7 +744,7 @@ impl Hierarchy {
             if a.child[i] == NONE {
                 continue;
             }
-            let mut bits = b.overlaps(&Query::new(&a.get(i)));
+            let mut bits = b.overlaps(&QueryBox::new(&a.get(i)));
             if marks_a >> i & 1 == 0 {
                 bits &= marks_b;
             }
@@ -821,7 +821,7 @@ impl Hierarchy {
                 if c == NONE {
                     continue;
                 }
-                let mut bits = node.overlaps(&Query::new(&node.get(i))) & (0xfe << i) & 0xff;
+                let mut bits = node.overlaps(&QueryBox::new(&node.get(i))) & (0xfe << i) & 0xff;
                 if dirty >> i & 1 == 0 {
                     bits &= u32::from(dirty);
                 }
@@ -855,7 +855,7 @@ impl Hierarchy {
             (other, cy, sx, bx, self.is_changed(sx))
         };
         let node = &tree.nodes[down as usize];
-        let mut bits = node.overlaps(&Query::new(&rest_box));
+        let mut bits = node.overlaps(&QueryBox::new(&rest_box));
         if !rest_changed {
             bits &= u32::from(node.marks(tree.epoch));
         }

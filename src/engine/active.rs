@@ -52,7 +52,7 @@ impl Active<'_> {
     }
 }
 
-/// Objects `start..start + count` of which the `lanes` bits are active (bit `k` for object
+/// Objects `start..start + count` of which the `active_lanes` bits are active (bit `k` for object
 /// `start + k`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Span {
@@ -61,14 +61,14 @@ pub(crate) struct Span {
     /// The objects that exist: the width, or fewer in the last span.
     pub count: usize,
     /// The active ones; never zero.
-    pub lanes: u64,
+    pub active_lanes: u64,
 }
 
 impl Span {
     /// True when every object of the span is active.
     #[inline(always)]
     pub fn is_full(&self) -> bool {
-        self.lanes == low_bits(self.count)
+        self.active_lanes == low_bits(self.count)
     }
 }
 
@@ -111,7 +111,7 @@ fn span<W: SpanWidth>(start: usize, len: usize, lanes: u64) -> Span {
     Span {
         start,
         count,
-        lanes: lanes & low_bits(count),
+        active_lanes: lanes & low_bits(count),
     }
 }
 
@@ -257,7 +257,7 @@ impl<W: SpanWidth> Iterator for ListSpans<'_, W> {
             return Some(Span {
                 start: first,
                 count: 1,
-                lanes: 1,
+                active_lanes: 1,
             });
         }
         let start = first - first % W::OBJECTS;
@@ -346,7 +346,7 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
                     ahead.enter(Span {
                         start: end,
                         count: 64,
-                        lanes: u64::MAX,
+                        active_lanes: u64::MAX,
                     });
                     end = words_end;
                 }
@@ -365,7 +365,7 @@ pub(crate) fn walk<W: SpanWidth>(set: impl Subset, len: usize, visit: &mut impl 
             // lines are requested now, to arrive while this run computes.
             if let Some(next) = pending {
                 let reach = next.count.min(RUN_AHEAD).min(end - span.start);
-                let head = next.lanes & (u64::MAX >> (64 - reach));
+                let head = next.active_lanes & (u64::MAX >> (64 - reach));
                 let mut bits = head & (head ^ head << 1 | 0x5555_5555_5555_5555);
                 while bits != 0 {
                     visit.request(next.start + bits.trailing_zeros() as usize);
@@ -550,11 +550,11 @@ mod tests {
         for s in set.spans::<W>(len) {
             assert_eq!(s.start % W::OBJECTS, 0);
             assert_eq!(s.count, W::OBJECTS.min(len - s.start));
-            assert_ne!(s.lanes, 0);
-            assert_eq!(s.lanes & !low_bits(s.count), 0);
+            assert_ne!(s.active_lanes, 0);
+            assert_eq!(s.active_lanes & !low_bits(s.count), 0);
             out.extend(
                 (0..s.count)
-                    .filter(|k| s.lanes >> k & 1 != 0)
+                    .filter(|k| s.active_lanes >> k & 1 != 0)
                     .map(|k| s.start + k),
             );
         }
@@ -603,7 +603,7 @@ mod tests {
             self.run.extend(start..end);
         }
         fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
-            for k in (0..span.count).filter(|k| span.lanes >> k & 1 != 0) {
+            for k in (0..span.count).filter(|k| span.active_lanes >> k & 1 != 0) {
                 ahead.advance(1);
                 for i in ahead.requests() {
                     self.request(i);
@@ -766,14 +766,14 @@ mod tests {
         for span in set.spans::<W>(len) {
             ahead.enter(span);
             if whole && !span.is_full() {
-                ahead.advance(span.lanes.count_ones() as usize);
+                ahead.advance(span.active_lanes.count_ones() as usize);
                 requested.extend(ahead.requests());
             }
             if span.is_full() {
                 (excused, after_whole) = (AHEAD, true);
                 continue;
             }
-            let ones = (0..span.count).filter(|k| span.lanes >> k & 1 != 0);
+            let ones = (0..span.count).filter(|k| span.active_lanes >> k & 1 != 0);
             // Whole, a span's objects past the first `AHEAD` may run unrequested.
             for k in ones.take(if whole { AHEAD } else { 64 }) {
                 if !whole {

@@ -139,10 +139,10 @@ impl AosRun<'_> {
     pub fn run<T: Transform3>(self, maps: Maps<'_, T>, backend: Backend) {
         debug_assert!(matches!(self.sink, AosSink::Fat(..)) || self.active == Active::All);
         match self.active {
-            Active::All => simd::dispatch_groups(backend, Every { run: self, maps }),
+            Active::All => simd::dispatch_groups(backend, EveryInGroups { run: self, maps }),
             // A list's objects are scattered: they run in no group, compiled once for the
             // baseline.
-            Active::Indices(ix) => Scattered {
+            Active::Indices(ix) => SubsetInGroups {
                 run: self,
                 maps,
                 set: List(ix),
@@ -151,7 +151,7 @@ impl AosRun<'_> {
             .run::<1, Vec3A>(),
             Active::Mask(words) => simd::dispatch_groups(
                 backend,
-                Scattered {
+                SubsetInGroups {
                     run: self,
                     maps,
                     set: Mask(words),
@@ -247,13 +247,13 @@ impl AosCall<'_> {
     /// The lane loop with `poses` into `sink`, on the scalar backend.
     fn sink<P: PoseSource<3>>(self, poses: P, sink: AosSink<'_>) {
         match sink {
-            AosSink::Store(out) => self.lanes(poses, Store { out, stream: false }),
-            AosSink::Fat(fat, _) => self.lanes(poses, fat),
+            AosSink::Store(out) => self.lane_loop(poses, Store { out, stream: false }),
+            AosSink::Fat(fat, _) => self.lane_loop(poses, fat),
         }
     }
 
     /// The lane loop with `poses` into `sink`.
-    fn lanes<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
+    fn lane_loop<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
         let engine = Engine {
             local: self.local,
             poses,
@@ -459,36 +459,36 @@ macro_rules! each_kernel {
     }};
 }
 
-/// Every object.
-struct Every<'a, 'm, T> {
+/// The AoS loop, in groups of boxes, over every object.
+struct EveryInGroups<'a, 'm, T> {
     run: AosRun<'a>,
     maps: Maps<'m, T>,
 }
 
-impl<T: Transform3> GroupJob for Every<'_, '_, T> {
+impl<T: Transform3> GroupJob for EveryInGroups<'_, '_, T> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
         each_kernel!(self.run, self.maps, W, P, whole);
     }
 }
 
-/// The objects of an index list or a mask: `A`, a [`Subset`] of one kind, in spans of
-/// `Sp`.
-struct Scattered<'a, 'm, T, A, Sp> {
+/// The AoS loop, in groups of boxes, over the objects of an index list or a mask: `A`, a
+/// [`Subset`] of one kind, in spans of `Sp`.
+struct SubsetInGroups<'a, 'm, T, A, Sp> {
     run: AosRun<'a>,
     maps: Maps<'m, T>,
     set: A,
     width: PhantomData<Sp>,
 }
 
-impl<T: Transform3, A: Subset, Sp: SpanWidth> GroupJob for Scattered<'_, '_, T, A, Sp> {
+impl<T: Transform3, A: Subset, Sp: SpanWidth> GroupJob for SubsetInGroups<'_, '_, T, A, Sp> {
     #[inline(always)]
     fn run<const W: usize, P: BoxGroup<W>>(self) {
         each_kernel!(self.run, self.maps, W, P, scattered, (self.set, self.width));
     }
 }
 
-/// [`Every`] with one method, rounding and pose kind.
+/// [`EveryInGroups`] with one method, rounding and pose kind.
 #[inline(always)]
 fn whole<T: Transform3, const W: usize, P: BoxGroup<W>>(
     run: AosRun<'_>,
@@ -557,7 +557,7 @@ impl<T: Transform3, const W: usize, P: BoxGroup<W>> Visit for Objects<'_, '_, T,
     /// requests stalls the loop once the line fill buffers are full).
     #[inline(always)]
     fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
-        let mut bits = span.lanes;
+        let mut bits = span.active_lanes;
         while bits != 0 {
             let i = span.start + bits.trailing_zeros() as usize;
             ahead.advance(1);

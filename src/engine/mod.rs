@@ -298,10 +298,10 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
     pub fn run_lanes(self, backend: Backend, fused: bool) {
         if S::EVERY {
             debug_assert_eq!(self.active, Active::All);
-            return Self::dispatch(backend, fused, Every(self.split().1));
+            return Self::dispatch(backend, fused, EveryInLanes(self.split().1));
         }
         match self.split() {
-            (Active::All, run) => Self::dispatch(backend, fused, Every(run)),
+            (Active::All, run) => Self::dispatch(backend, fused, EveryInLanes(run)),
             // A dense list runs as a mask, in lanes; a sparse one an entry at a time, in one
             // lane, where spans of the lane width would rarely hold two of its objects.
             // So the lane loop compiles no walk that builds spans from a list: that walk
@@ -312,19 +312,19 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
                 Self::dispatch(
                     backend,
                     fused,
-                    Scattered {
+                    SubsetInLanes {
                         run,
                         set: Mask(&words),
                     },
                 )
             }
             (Active::Indices(ix), run) => {
-                Self::dispatch(backend, fused, Scattered { run, set: List(ix) })
+                Self::dispatch(backend, fused, SubsetInLanes { run, set: List(ix) })
             }
             (Active::Mask(words), run) => Self::dispatch(
                 backend,
                 fused,
-                Scattered {
+                SubsetInLanes {
                     run,
                     set: Mask(words),
                 },
@@ -359,9 +359,9 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
     #[cfg(test)]
     pub fn run_in<L: LaneArray>(self) {
         match self.split() {
-            (Active::All, run) => Job::run::<L>(Every(run)),
-            (Active::Indices(ix), run) => Job::run::<L>(Scattered { run, set: List(ix) }),
-            (Active::Mask(words), run) => Job::run::<L>(Scattered {
+            (Active::All, run) => Job::run::<L>(EveryInLanes(run)),
+            (Active::Indices(ix), run) => Job::run::<L>(SubsetInLanes { run, set: List(ix) }),
+            (Active::Mask(words), run) => Job::run::<L>(SubsetInLanes {
                 run,
                 set: Mask(words),
             }),
@@ -420,17 +420,18 @@ where
     /// kernel in a mask's walk").
     #[inline(always)]
     fn part<U: Upcoming>(&mut self, span: Span, ahead: &mut Lookahead<U>) {
-        ahead.advance(span.lanes.count_ones() as usize);
+        ahead.advance(span.active_lanes.count_ones() as usize);
         for i in ahead.requests() {
             self.request(i);
         }
         let (method, outward) = (self.method, self.outward);
         if W::OBJECTS == L::WIDTH {
             self.run
-                .lanes::<L>(span.start, span.count, span.lanes, method, outward);
+                .run_span::<L>(span.start, span.count, span.active_lanes, method, outward);
         } else {
             debug_assert_eq!(span.count, 1);
-            self.run.lanes::<L::One>(span.start, 1, 1, method, outward);
+            self.run
+                .run_span::<L::One>(span.start, 1, 1, method, outward);
         }
     }
 
@@ -440,16 +441,18 @@ where
     }
 }
 
-/// Every object: the job of [`Active::All`].
-struct Every<const N: usize, B, P, S>(Run<N, B, P, S>);
+/// The lane loop over every object ([`Active::All`]).
+struct EveryInLanes<const N: usize, B, P, S>(Run<N, B, P, S>);
 
-/// The objects of a list or a mask: `A`, a [`Subset`] of one kind.
-struct Scattered<const N: usize, B, P, S, A> {
+/// The lane loop over the objects of a list or a mask: `A`, a [`Subset`] of one kind.
+struct SubsetInLanes<const N: usize, B, P, S, A> {
     run: Run<N, B, P, S>,
     set: A,
 }
 
-impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Job for Every<N, B, P, S> {
+impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Job
+    for EveryInLanes<N, B, P, S>
+{
     /// One loop per method, so that each is specialised to its kernel; the rounding is a
     /// loop-invariant branch. The scalar reference (lanes of one) has one loop, the method
     /// a run-time value: it is there to be checked against, not to be fast
@@ -465,9 +468,9 @@ impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Job for Ever
 }
 
 impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>, A: Subset> Job
-    for Scattered<N, B, P, S, A>
+    for SubsetInLanes<N, B, P, S, A>
 {
-    /// As for [`Every`].
+    /// As for [`EveryInLanes`].
     #[inline(always)]
     fn run<L: LaneArray>(self) {
         let (mut run, set) = (self.run.trim(), self.set);
@@ -528,7 +531,7 @@ where
     fn range<L: LaneArray>(&mut self, start: usize, end: usize, method: Method, outward: bool) {
         let (w, mut i) = (L::WIDTH, start);
         while i + w <= end {
-            self.lanes::<L>(i, w, u64::MAX >> (64 - w), method, outward);
+            self.run_span::<L>(i, w, u64::MAX >> (64 - w), method, outward);
             i += w;
         }
         // The tail. A sink that takes every object (a transform's) runs it one object at a
@@ -539,12 +542,12 @@ where
         // type of one object, the scalar reference's, has no tail.)
         if S::EVERY {
             while L::WIDTH > 1 && i < end {
-                self.lanes::<L::One>(i, 1, 1, method, outward);
+                self.run_span::<L::One>(i, 1, 1, method, outward);
                 i += 1;
             }
         } else if i < end {
             let count = end - i;
-            self.lanes::<L>(i, count, u64::MAX >> (64 - count), method, outward);
+            self.run_span::<L>(i, count, u64::MAX >> (64 - count), method, outward);
         }
     }
 
@@ -563,11 +566,11 @@ where
     /// fused multiply-add is correctly rounded with or without the instruction).
     #[cfg_attr(not(debug_assertions), inline(always))]
     #[cfg_attr(debug_assertions, inline(never))]
-    fn lanes<L: LaneArray>(
+    fn run_span<L: LaneArray>(
         &mut self,
         i: usize,
         count: usize,
-        lanes: u64,
+        active_lanes: u64,
         method: Method,
         outward: bool,
     ) {
@@ -579,6 +582,7 @@ where
             method,
             rounding: self.rounding,
         };
-        self.sink.span(i, count, lanes, [min, max], redo, &extended);
+        self.sink
+            .span(i, count, active_lanes, [min, max], redo, &extended);
     }
 }

@@ -77,8 +77,8 @@ impl NamedCall<'_> {
             unreachable!("blocks of boxes and of rigid poses name themselves so (tested)");
         };
         match sink {
-            LaneSink::Store(sink) => self.lanes(local, poses, local.len() * 8, sink),
-            LaneSink::Fat(sink) => self.lanes(local, poses, local.len() * 8, sink),
+            LaneSink::Store(sink) => self.lane_loop(local, poses, local.len() * 8, sink),
+            LaneSink::Fat(sink) => self.lane_loop(local, poses, local.len() * 8, sink),
         }
     }
 
@@ -93,7 +93,7 @@ impl NamedCall<'_> {
             unreachable!("columns of boxes and of rigid poses name themselves so (tested)");
         };
         let len = local.columns[0].len();
-        self.lanes(local, Rigid3SoaRef::new(poses), len, sink);
+        self.lane_loop(local, Rigid3SoaRef::new(poses), len, sink);
     }
 
     /// [`Route::Aos2`] into `sink`: the lane loop over AoS 2D boxes and rigid poses, on
@@ -103,11 +103,11 @@ impl NamedCall<'_> {
         let (NamedBoxes::Aos2(local), NamedPoses::Rigid2(poses)) = (self.local, self.poses) else {
             unreachable!("2D boxes and rigid poses name themselves so (tested)");
         };
-        self.lanes(local, poses, local.len(), sink);
+        self.lane_loop(local, poses, local.len(), sink);
     }
 
     /// The lane loop over `len` objects into `sink`.
-    fn lanes<const N: usize, B: BoxSource<N>, P: PoseSource<N>>(
+    fn lane_loop<const N: usize, B: BoxSource<N>, P: PoseSource<N>>(
         self,
         local: B,
         poses: P,

@@ -14,13 +14,13 @@ use crate::simd::{self, BoxGroup, LaneArray};
 /// Where the lane loop's tight boxes go.
 pub(crate) trait Sink<const N: usize> {
     /// The tight boxes `[min, max]` of objects `i..i + count` in lanes, of which the
-    /// `lanes` bits are active. Where `redo` is nonzero the lane's box does not stand and
+    /// `active_lanes` bits are active. Where `redo` is nonzero the lane's box does not stand and
     /// must be replaced by `extended.tight(i + k)`, its box on the extended path.
     fn span<L: LaneArray>(
         &mut self,
         i: usize,
         count: usize,
-        lanes: u64,
+        active_lanes: u64,
         tight: [Vector<L, N>; 2],
         redo: L,
         extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
@@ -64,13 +64,13 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
         &mut self,
         i: usize,
         count: usize,
-        lanes: u64,
+        active_lanes: u64,
         [min, max]: [Vector<L, N>; 2],
         redo: L,
         extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
     ) {
         // Every object is active: a store writes whole spans.
-        debug_assert_eq!(lanes.count_ones() as usize, count);
+        debug_assert_eq!(active_lanes.count_ones() as usize, count);
         if self.stream {
             self.out.store_streaming(i, count, min, max);
         } else {
@@ -134,7 +134,7 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
         &mut self,
         i: usize,
         count: usize,
-        lanes: u64,
+        active_lanes: u64,
         tight: [Vector<L, N>; 2],
         redo: L,
         extended: &Extended<'_, impl BoxSource<N> + Clone, impl PoseSource<N> + Clone>,
@@ -149,7 +149,7 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
         // the boxes that stay with their own bits; out of line with the rarer cases, it
         // was most of an update where many bodies move (`docs/decisions.md`, "A whole
         // span's store in line").
-        if count == L::WIDTH && lanes == u64::MAX >> (64 - L::WIDTH) && !redo.any_nonzero() {
+        if count == L::WIDTH && active_lanes == u64::MAX >> (64 - L::WIDTH) && !redo.any_nonzero() {
             self.blend(i, count, -outside, tight, [fat_min, fat_max]);
             self.moved.record(i, u64::from(outside.nonzero_mask()));
             return;
@@ -157,7 +157,7 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
         self.rewrite(
             i,
             count,
-            lanes,
+            active_lanes,
             [outside.portable(), redo.portable()],
             tight.map(L::portable_vector),
             [fat_min, fat_max].map(L::portable_vector),
@@ -216,7 +216,7 @@ impl<F> Fat<'_, F> {
         &mut self,
         i: usize,
         count: usize,
-        lanes: u64,
+        active_lanes: u64,
         [outside, redo]: [L; 2],
         [min, max]: [Vector<L, N>; 2],
         [fat_min, fat_max]: [Vector<L, N>; 2],
@@ -224,9 +224,9 @@ impl<F> Fat<'_, F> {
     ) where
         F: BoxSink<N>,
     {
-        let redo_lanes = u64::from(redo.nonzero_mask()) & lanes;
-        let left = u64::from(outside.nonzero_mask()) & lanes & !redo_lanes;
-        if left != 0 && lanes != u64::MAX >> (64 - count) {
+        let redo_lanes = u64::from(redo.nonzero_mask()) & active_lanes;
+        let left = u64::from(outside.nonzero_mask()) & active_lanes & !redo_lanes;
+        if left != 0 && active_lanes != u64::MAX >> (64 - count) {
             // A span shared with inactive objects: only the boxes rewritten are stored, so
             // that an inactive object's fat box is never written.
             let (grown_min, grown_max) = self.margin.grow(min, max);

@@ -5,7 +5,7 @@
 //! bottom-up pass (refit) is a reverse scan, and the left child of a node that is not a
 //! primitive is the next node.
 
-use super::nodes::{PrimBox, Ref, Store};
+use super::nodes::{NodeAccess, PrimBox, Ref};
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -39,7 +39,7 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
     let mut root = Ref::primitive(0);
     // (start, end, slot): the range to place and where its reference goes.
     #[derive(Clone, Copy)]
-    enum Slot {
+    enum ParentLink {
         Root,
         Child(usize, usize),
     }
@@ -47,7 +47,7 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
     // level off adversarial input (O(n²)); with the guard the depth, and so the work per
     // primitive, stays O(log n).
     let max_depth = 2 * (usize::BITS - n.leading_zeros()) as usize + 16;
-    let mut work = vec![(0usize, n, Slot::Root, 0usize)];
+    let mut work = vec![(0usize, n, ParentLink::Root, 0usize)];
     while let Some((start, end, slot, depth)) = work.pop() {
         let r = if end - start == 1 {
             Ref::primitive(ids[start])
@@ -61,13 +61,13 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
                 median(boxes, range)
             } + start;
             // Right first, so that the left range is placed next (pre-order).
-            work.push((mid, end, Slot::Child(index, 1), depth + 1));
-            work.push((start, mid, Slot::Child(index, 0), depth + 1));
+            work.push((mid, end, ParentLink::Child(index, 1), depth + 1));
+            work.push((start, mid, ParentLink::Child(index, 0), depth + 1));
             Ref::node(index as u32)
         };
         match slot {
-            Slot::Root => root = r,
-            Slot::Child(parent, side) => children[parent][side] = r,
+            ParentLink::Root => root = r,
+            ParentLink::Child(parent, side) => children[parent][side] = r,
         }
     }
     Topology { children, root }
@@ -188,7 +188,7 @@ pub(crate) fn node_boxes(
 }
 
 /// A layout over a topology whose primitive `i` has the box `prim(i)`.
-pub(crate) fn layout<L: Store>(children: &[[Ref; 2]], prim: impl Fn(u32) -> PrimBox) -> L {
+pub(crate) fn layout<L: NodeAccess>(children: &[[Ref; 2]], prim: impl Fn(u32) -> PrimBox) -> L {
     let (min, max) = node_boxes(children, &prim);
     L::from_boxes(children, &min, &max, prim)
 }

@@ -118,10 +118,10 @@ pub(crate) fn outward(min: [f32; 3], max: [f32; 3]) -> ([f32; 3], [f32; 3]) {
 }
 
 /// How a tree stores its inner nodes: [`Compact`] or [`Quantized`].
-pub trait Layout: Store + Clone + core::fmt::Debug {}
+pub trait Layout: NodeAccess + Clone + core::fmt::Debug {}
 
 /// The crate-private access every layout gives the builder and the queries.
-pub(crate) trait Store {
+pub(crate) trait NodeAccess {
     /// The layout over `children`, whose node `i` has the exact box `[min[i], max[i]]` and
     /// primitive `p` the exact box `prim(p)`.
     fn from_boxes(
@@ -211,7 +211,7 @@ impl Compact {
     }
 }
 
-impl Store for Compact {
+impl NodeAccess for Compact {
     fn from_boxes(
         children: &[[Ref; 2]],
         min: &[[f32; 3]],
@@ -352,7 +352,7 @@ fn grid_box_f64(origin: Vec3A, step: Vec3A, c: [i16; 3], e: [u16; 3]) -> (DVec3,
     (origin.as_dvec3() + step * c, step * e)
 }
 
-impl Store for Quantized {
+impl NodeAccess for Quantized {
     fn from_boxes(
         children: &[[Ref; 2]],
         min: &[[f32; 3]],
@@ -440,7 +440,7 @@ pub struct Paired {
 
 impl Layout for Paired {}
 
-impl Store for Paired {
+impl NodeAccess for Paired {
     const STORES_PRIMITIVES: bool = true;
 
     fn from_boxes(

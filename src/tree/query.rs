@@ -7,8 +7,8 @@ use core::ops::ControlFlow;
 use glam::{DVec3, Vec3A};
 
 use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
-use super::nodes::{Child, Layout, Ref, Store};
-use super::relative::{Axes, Crosswise, Lanes, QueryError, Relative};
+use super::nodes::{Child, Layout, NodeAccess, Ref};
+use super::relative::{AxesOf, Crosswise, Lanes, QueryError, Relative};
 use super::triangle::{
     LANES, TriangleLanes, filter_batch, triangles_distance_sq, triangles_intersect,
 };
@@ -241,7 +241,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             // (`Below`), placed on the primitive's tree's axes, against its box.
             if ra.is_primitive() {
                 let below = Below::new(lb, rb.index(), prim_b);
-                let keep = self.keep_against(&cross, &below, Axes::OfA, (ca, ea), margin);
+                let keep = self.keep_against(&cross, &below, AxesOf::A, (ca, ea), margin);
                 stats.node_pairs += u64::from(below.valid.count_ones());
                 stack.push_kept(keep, |l| {
                     let k = below.kids[l];
@@ -251,7 +251,7 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
             }
             if rb.is_primitive() {
                 let below = Below::new(la, ra.index(), prim_a);
-                let keep = self.keep_against(&cross, &below, Axes::OfB, (cb, eb), margin);
+                let keep = self.keep_against(&cross, &below, AxesOf::B, (cb, eb), margin);
                 stats.node_pairs += u64::from(below.valid.count_ones());
                 stack.push_kept(keep, |l| {
                     let k = below.kids[l];
@@ -312,19 +312,19 @@ impl<A: Shape, B: Shape> Query<'_, A, B> {
         &self,
         cross: &Crosswise,
         below: &Below,
-        axes: Axes,
+        axes: AxesOf,
         one: (Vec3A, Vec3A),
         margin: f64,
     ) -> u32 {
         let rel = &self.relative;
-        let (placed, one_placed) = if axes == Axes::OfA {
+        let (placed, one_placed) = if axes == AxesOf::A {
             (
-                cross.place_on(Axes::OfA, &below.lanes),
+                cross.place_on(AxesOf::A, &below.lanes),
                 rel.on_b(one.0, one.1),
             )
         } else {
             (
-                cross.place_on(Axes::OfB, &below.lanes),
+                cross.place_on(AxesOf::B, &below.lanes),
                 rel.on_a(one.0, one.1),
             )
         };
@@ -332,7 +332,7 @@ impl<A: Shape, B: Shape> Query<'_, A, B> {
         if self.cross_near_leaves {
             for (l, kid) in below.kids.iter().enumerate() {
                 let kid_box = (kid.center, kid.extent);
-                let ((ca, ea), (cb, eb)) = if axes == Axes::OfA {
+                let ((ca, ea), (cb, eb)) = if axes == AxesOf::A {
                     (one, kid_box)
                 } else {
                     (kid_box, one)
@@ -357,7 +357,7 @@ struct Below {
 
 impl Below {
     #[inline(always)]
-    fn new<L: Store>(layout: &L, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A) + Copy) -> Self {
+    fn new<L: NodeAccess>(layout: &L, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A) + Copy) -> Self {
         let open = |c: Child| {
             if c.r.is_primitive() {
                 ([c, c], 0b01)

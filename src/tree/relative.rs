@@ -526,11 +526,11 @@ pub(crate) struct Crosswise {
 
 /// Which tree's axes boxes in lanes are placed on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Axes {
+pub(crate) enum AxesOf {
     /// `A`'s: the boxes are `B`'s.
-    OfA,
+    A,
     /// `B`'s: the boxes are `A`'s.
-    OfB,
+    B,
 }
 
 /// Boxes `x` placed by `(map, |map|)`.
@@ -553,9 +553,9 @@ impl Crosswise {
 
     /// Four boxes of one tree placed on `axes`, the other tree's.
     #[inline(always)]
-    pub(crate) fn place_on(&self, axes: Axes, x: &Lanes) -> Lanes {
+    pub(crate) fn place_on(&self, axes: AxesOf, x: &Lanes) -> Lanes {
         placed_by(
-            if axes == Axes::OfA {
+            if axes == AxesOf::A {
                 &self.on_a
             } else {
                 &self.on_b
@@ -676,9 +676,9 @@ mod tests {
             }
             // Four boxes of either tree against one of the other.
             let (c, e) = (corner(), corner().abs());
-            for axes in [Axes::OfA, Axes::OfB] {
+            for axes in [AxesOf::A, AxesOf::B] {
                 let x_placed = cross.place_on(axes, &x);
-                let of_a = axes == Axes::OfA;
+                let of_a = axes == AxesOf::A;
                 let one_placed = if of_a { rel.on_b(c, e) } else { rel.on_a(c, e) };
                 let p = |c, e| if of_a { rel.on_a(c, e) } else { rel.on_b(c, e) };
                 let mask = cross.apart_from(&x, &x_placed, (c, e), &one_placed);
