@@ -143,7 +143,8 @@ mod tests {
 
     use super::*;
     use crate::aabb::{Aabb2, Aabb3};
-    use crate::engine::{Active, Engine, Store};
+    use crate::engine::{Active, Engine, Fat, NamedSink, SinkRoute, Store};
+    use crate::fat::{Margin, Moved};
     use crate::layout::{Aabb3x8, Block8, NamedBoxes, NamedBoxesMut, Route, Soa, TransformSource};
     use crate::simd::{F32s, LaneArray};
     use crate::transform::NamedPoses;
@@ -205,17 +206,25 @@ mod tests {
                 .all(|(p, q)| (0..3).all(|i| eq(p.min[i], q.min[i]) && eq(p.max[i], q.max[i])))
     }
 
-    /// The route the layouts' types name: where it is not generic, every source and the
-    /// output name themselves for it (so the `unreachable!`s of [`Engine::run`], of the
-    /// sinks' `run_named` and of `NamedCall` are never reached), with the kind it says.
+    /// The route the layouts' types name: where it is not generic, every source and both
+    /// sinks over the output name themselves with that route's variants, as the dispatch
+    /// matches them (so its one `unreachable!` is never reached).
     fn route<const N: usize, B: BoxSource<N>, X: PoseSource<N>, O: BoxSink<N>>(
         local: B,
         xf: X,
-        mut out: O,
+        out: O,
     ) -> Route {
+        fn kind(boxes: &NamedBoxesMut<'_>) -> &'static str {
+            match boxes {
+                NamedBoxesMut::Aos(_) => "AoS",
+                NamedBoxesMut::Blocks(_) => "blocks",
+                NamedBoxesMut::Soa(_) => "columns",
+                NamedBoxesMut::Aos2(_) => "AoS 2D",
+            }
+        }
         let route = Engine::<N, B, X, Store<O>>::ROUTE;
         // An update's sink takes the same routes, but for the columns' and the 2D one.
-        let fat = Engine::<N, B, X, crate::engine::Fat<'_, O>>::ROUTE;
+        let fat = Engine::<N, B, X, Fat<'_, O>>::ROUTE;
         assert_eq!(
             fat,
             if matches!(route, Route::Soa | Route::Aos2) {
@@ -225,26 +234,58 @@ mod tests {
             }
         );
         let predicted = xf.named_predicted();
-        let named = (local.named(), xf.named(), out.named_mut());
-        let aos = |p: &NamedPoses| !matches!(p, NamedPoses::Rigid3x8(_));
+        let (local, poses) = (local.named(), xf.named());
+        let mut moved = Moved::new();
+        let mut fat = Fat {
+            fat: out,
+            margin: Margin::ZERO,
+            moved: &mut moved,
+        };
+        let fat_out = match fat.named() {
+            Some(NamedSink::Fat { fat, .. }) => Some(kind(&fat)),
+            Some(NamedSink::Store { .. }) => panic!("a fat sink names itself Store"),
+            None => None,
+        };
+        let mut store = Store {
+            out: fat.fat,
+            stream: false,
+        };
+        let out = match store.named() {
+            Some(NamedSink::Store { out, .. }) => Some(out),
+            Some(NamedSink::Fat { .. }) => panic!("a plain sink names itself Fat"),
+            None => None,
+        };
+        // The fat sink names the same output as the plain one.
+        assert_eq!(fat_out, out.as_ref().map(kind));
+        let named = (local, poses, out);
         match route {
             Route::Generic => {}
             Route::Aos => assert!(
                 matches!(
                     named,
-                    (Some(NamedBoxes::Aos(_)), Some(p), Some(NamedBoxesMut::Aos(_))) if aos(&p)
+                    (
+                        Some(NamedBoxes::Aos(_)),
+                        Some(NamedPoses::Aos(_)),
+                        Some(NamedBoxesMut::Aos(_))
+                    )
                 ) && predicted.is_none()
             ),
             Route::Swept => assert!(matches!(
                 (named, predicted),
-                ((Some(NamedBoxes::Aos(_)), Some(p), Some(NamedBoxesMut::Aos(_))), Some(q))
-                    if aos(&p) && aos(&q)
+                (
+                    (
+                        Some(NamedBoxes::Aos(_)),
+                        Some(NamedPoses::Aos(_)),
+                        Some(NamedBoxesMut::Aos(_))
+                    ),
+                    Some(NamedPoses::Aos(_))
+                )
             )),
             Route::Blocks => assert!(matches!(
                 named,
                 (
                     Some(NamedBoxes::Blocks(_)),
-                    Some(NamedPoses::Rigid3x8(_)),
+                    Some(NamedPoses::Blocks(_)),
                     Some(NamedBoxesMut::Blocks(_))
                 )
             )),
@@ -252,7 +293,7 @@ mod tests {
                 named,
                 (
                     Some(NamedBoxes::Soa(_)),
-                    Some(NamedPoses::Rigid3Soa(_)),
+                    Some(NamedPoses::Soa(_)),
                     Some(NamedBoxesMut::Soa(_))
                 )
             )),
@@ -260,7 +301,7 @@ mod tests {
                 named,
                 (
                     Some(NamedBoxes::Aos2(_)),
-                    Some(NamedPoses::Rigid2(_)),
+                    Some(NamedPoses::Aos2(_)),
                     Some(NamedBoxesMut::Aos2(_))
                 )
             )),

@@ -69,6 +69,16 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
     }
 }
 
+impl<S> Window<'_, S> {
+    /// The window's part of AoS poses by name (any other name has no route in a part).
+    fn window<'p>(&self, poses: NamedPoses<'p>) -> Option<NamedPoses<'p>> {
+        match poses {
+            NamedPoses::Aos(poses) => window(poses, self.start, self.len).map(NamedPoses::Aos),
+            NamedPoses::Blocks(_) | NamedPoses::Soa(_) | NamedPoses::Aos2(_) => None,
+        }
+    }
+}
+
 impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
     // The whole source's length was checked.
     fn check_len(&self, _: usize) -> Result<(), BatchError> {
@@ -108,10 +118,10 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
         _ => Route::Generic,
     };
     fn named(&self) -> Option<NamedPoses<'_>> {
-        window(self.src.named()?, self.start, self.len)
+        self.window(self.src.named()?)
     }
     fn named_predicted(&self) -> Option<NamedPoses<'_>> {
-        window(self.src.named_predicted()?, self.start, self.len)
+        self.window(self.src.named_predicted()?)
     }
     type Trimmed = Self;
     #[inline(always)]

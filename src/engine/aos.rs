@@ -18,7 +18,7 @@ use crate::aabb::Aabb3;
 use crate::kernel::{MapKernel, gather};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
-use crate::transform::{Maps, NamedPoses, Rigid3, Similarity3, Transform3, Translation3, Trs3};
+use crate::transform::{AosPoses, Maps, Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of a span of a mask's walk ([`active::walk`]): a mask word's worth, whole
 /// words that follow each other run several boxes per vector (`docs/decisions.md`, "The
@@ -171,7 +171,7 @@ pub(crate) fn takes_aos(backend: Backend) -> bool {
 
 /// The poses of objects `start..start + len` (a shared pose stays whole), or `None` past
 /// the end: what one part of a parallel batch reads, or one block of a swept run.
-pub(crate) fn window(poses: NamedPoses<'_>, start: usize, len: usize) -> Option<NamedPoses<'_>> {
+pub(crate) fn window(poses: AosPoses<'_>, start: usize, len: usize) -> Option<AosPoses<'_>> {
     fn part<T>(maps: Maps<'_, T>, start: usize, len: usize) -> Option<Maps<'_, T>> {
         match maps {
             Maps::Each(poses) => Some(Maps::Each(poses.get(start..start.checked_add(len)?)?)),
@@ -179,24 +179,23 @@ pub(crate) fn window(poses: NamedPoses<'_>, start: usize, len: usize) -> Option<
         }
     }
     Some(match poses {
-        NamedPoses::Translation3(p) => NamedPoses::Translation3(part(p, start, len)?),
-        NamedPoses::Rigid3(p) => NamedPoses::Rigid3(part(p, start, len)?),
-        NamedPoses::Similarity3(p) => NamedPoses::Similarity3(part(p, start, len)?),
-        NamedPoses::Trs3(p) => NamedPoses::Trs3(part(p, start, len)?),
-        NamedPoses::Affine3A(p) => NamedPoses::Affine3A(part(p, start, len)?),
-        NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => return None,
+        AosPoses::Translation3(p) => AosPoses::Translation3(part(p, start, len)?),
+        AosPoses::Rigid3(p) => AosPoses::Rigid3(part(p, start, len)?),
+        AosPoses::Similarity3(p) => AosPoses::Similarity3(part(p, start, len)?),
+        AosPoses::Trs3(p) => AosPoses::Trs3(part(p, start, len)?),
+        AosPoses::Affine3A(p) => AosPoses::Affine3A(part(p, start, len)?),
     })
 }
 
-/// A run of the engine over AoS 3D boxes with AoS or shared poses ([`Engine::AOS`]), with
-/// the poses by name: what [`super::NamedCall::aos`] runs, once in bvkit for both sinks,
+/// A run of the engine over AoS 3D boxes with AoS or shared poses (`Route::Aos`), with
+/// the poses by name: what the AoS route ([`super::route`]) runs, once in bvkit for both sinks,
 /// not at every call site.
 #[derive(Clone, Copy)]
 pub(crate) struct AosCall<'a> {
     /// The local boxes.
     pub local: &'a [Aabb3],
     /// The poses.
-    pub poses: NamedPoses<'a>,
+    pub poses: AosPoses<'a>,
     /// The objects visited.
     pub active: Active<'a>,
     /// The method.
@@ -210,18 +209,15 @@ pub(crate) struct AosCall<'a> {
 impl AosCall<'_> {
     /// Runs into `sink`, with the poses in their class's type: the AoS loop, or on the
     /// scalar backend the lane loop. Called from one function only, which is neither
-    /// generic nor inlined ([`super::NamedCall::aos`]).
+    /// generic nor inlined (the AoS route's, in [`super::route`]).
     #[inline(always)]
     pub fn run(self, sink: AosSink<'_>) {
         match self.poses {
-            NamedPoses::Translation3(maps) => self.class::<Translation3>(maps, sink),
-            NamedPoses::Rigid3(maps) => self.class::<Rigid3>(maps, sink),
-            NamedPoses::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
-            NamedPoses::Trs3(maps) => self.class::<Trs3>(maps, sink),
-            NamedPoses::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
-            NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => {
-                unreachable!("blocks, columns and 2D poses take their own routes")
-            }
+            AosPoses::Translation3(maps) => self.class::<Translation3>(maps, sink),
+            AosPoses::Rigid3(maps) => self.class::<Rigid3>(maps, sink),
+            AosPoses::Similarity3(maps) => self.class::<Similarity3>(maps, sink),
+            AosPoses::Trs3(maps) => self.class::<Trs3>(maps, sink),
+            AosPoses::Affine3A(maps) => self.class::<glam::Affine3A>(maps, sink),
         }
     }
 
@@ -252,8 +248,9 @@ impl AosCall<'_> {
         }
     }
 
-    /// The lane loop with `poses` into `sink`.
+    /// The lane loop with `poses` into `sink`, in the scalar reference's lanes.
     fn lane_loop<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
+        debug_assert_eq!(self.backend, Backend::Scalar);
         let engine = Engine {
             local: self.local,
             poses,
@@ -263,7 +260,7 @@ impl AosCall<'_> {
             method: self.method,
             rounding: self.rounding,
         };
-        engine.run_lanes(self.backend, false);
+        engine.run_scalar();
     }
 }
 
@@ -280,7 +277,7 @@ impl AosCall<'_> {
     /// [`Batch::transform`](crate::Batch::transform) results, and a swept run compiles no
     /// loop of its own. An index list, and a block of a mask with few active objects, run
     /// one object at a time ([`tight`]), as the AoS loop runs a list.
-    pub fn swept(self, predicted: NamedPoses<'_>, mut sink: AosSink<'_>) {
+    pub fn swept(self, predicted: AosPoses<'_>, mut sink: AosSink<'_>) {
         let len = self.local.len();
         let one = |i: usize| {
             let at = |poses| tight(poses, i, &self.local[i], self.method, self.rounding);
@@ -408,21 +405,18 @@ impl GroupJob for Unite<'_, '_> {
 /// Object `i`'s tight box from its local box `local`, by the single-box kernel (the bits
 /// of [`Tight::of`], which every backend's AoS run gives).
 fn tight(
-    poses: NamedPoses<'_>,
+    poses: AosPoses<'_>,
     i: usize,
     local: &Aabb3,
     method: Method,
     rounding: Rounding,
 ) -> Aabb3 {
     match poses {
-        NamedPoses::Translation3(p) => local.transformed(p.at(i), method, rounding),
-        NamedPoses::Rigid3(p) => local.transformed(p.at(i), method, rounding),
-        NamedPoses::Similarity3(p) => local.transformed(p.at(i), method, rounding),
-        NamedPoses::Trs3(p) => local.transformed(p.at(i), method, rounding),
-        NamedPoses::Affine3A(p) => local.transformed(p.at(i), method, rounding),
-        NamedPoses::Rigid3x8(_) | NamedPoses::Rigid3Soa(_) | NamedPoses::Rigid2(_) => {
-            unreachable!("blocks, columns and 2D poses take their own routes")
-        }
+        AosPoses::Translation3(p) => local.transformed(p.at(i), method, rounding),
+        AosPoses::Rigid3(p) => local.transformed(p.at(i), method, rounding),
+        AosPoses::Similarity3(p) => local.transformed(p.at(i), method, rounding),
+        AosPoses::Trs3(p) => local.transformed(p.at(i), method, rounding),
+        AosPoses::Affine3A(p) => local.transformed(p.at(i), method, rounding),
     }
 }
 

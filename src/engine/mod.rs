@@ -9,14 +9,11 @@
 //! - the AoS loop, for AoS 3D boxes with AoS or shared poses, on the single-box kernel
 //!   (glam's `Vec3A`), on every backend but the scalar one.
 //!
-//! The layouts of a route ([`Engine::ROUTE`]: AoS 3D boxes with AoS or shared poses, or a
-//! `Swept` pair of them; AoSoA blocks of 3D boxes with blocks of rigid poses; and, in a
-//! transform, SoA columns of 3D boxes with columns of rigid poses, and AoS 2D boxes with
-//! AoS rigid 2D poses) run in code compiled here once: [`Engine::run`] hands them over by
-//! name to the sink ([`Sink::run_named`]), which calls [`NamedCall::aos`] (the AoS loop, or
-//! on the scalar backend the lane loop), [`NamedCall::blocks`], [`NamedCall::soa`] or
-//! [`NamedCall::aos2`] (the lane loop). Every other layout runs the lane loop compiled
-//! where it is called.
+//! The layouts of a route (AoS 3D boxes with AoS or shared poses, or a `Swept` pair of
+//! them; AoSoA blocks of 3D boxes with blocks of rigid poses; and, in a transform, SoA
+//! columns of 3D boxes with columns of rigid poses, and AoS 2D boxes with AoS rigid 2D
+//! poses) run in code compiled here once: [`Engine::run`] hands them over by name
+//! ([`route`]). Every other layout runs the lane loop compiled where it is called.
 
 /// `$body` once per method, with `$m` bound to it as a constant, so that each copy is
 /// specialised to its kernel: the one place the methods are spelled out. With `if $cond`
@@ -51,14 +48,15 @@ macro_rules! specialise {
 
 mod active;
 mod aos;
-mod named;
+mod route;
 mod sink;
 
 pub use active::Active;
 #[cfg(feature = "rayon")]
 pub(crate) use aos::window;
 pub(crate) use aos::{AosCall, CHUNK};
-pub(crate) use named::{LaneSink, NamedCall};
+#[cfg(test)]
+pub(crate) use route::{NamedSink, SinkRoute};
 pub(crate) use sink::{AosSink, Fat, Sink, Store};
 
 use active::{
@@ -124,7 +122,7 @@ pub trait PoseSource<const N: usize> {
     /// returns them where it is not [`Route::Generic`] (and their class is 3D).
     const ROUTE: Route = Route::Generic;
     #[doc(hidden)]
-    /// The poses by name (a [`Swept`](crate::Swept) pair's current ones).
+    /// The poses by name (a [`Swept`](crate::Swept) pair's current ones): see [`route`].
     fn named(&self) -> Option<NamedPoses<'_>> {
         None
     }
@@ -184,12 +182,7 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
     const ROUTE: Route = X::ROUTE;
     #[inline(always)]
     fn named(&self) -> Option<NamedPoses<'_>> {
-        match X::ROUTE {
-            Route::Aos | Route::Aos2 => X::Class::named(self.maps()?),
-            Route::Blocks => Some(NamedPoses::Rigid3x8(self.rigid3x8s()?)),
-            Route::Soa => Some(NamedPoses::Rigid3Soa(self.rigid3_columns()?.columns)),
-            Route::Generic | Route::Swept => None,
-        }
+        TransformSource::named(self)
     }
 }
 
@@ -256,52 +249,34 @@ pub(crate) struct Engine<'a, const N: usize, B, P, S> {
 }
 
 impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'a, N, B, P, S> {
-    /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): the layouts of a
-    /// [`Route`] in code compiled once in bvkit (the AoS loop, or the lane loop), every
-    /// other layout in the lane loop, compiled here.
+    /// Runs in lanes on `backend` (`fused` lets the lanes fuse multiply-adds).
     #[inline(always)]
-    pub fn run(self, backend: Backend, fused: bool) {
-        if Self::GENERIC {
-            return self.run_lanes(backend, fused);
-        }
-        let Engine {
-            local,
-            poses,
-            sink,
-            active,
-            method,
-            rounding,
-            ..
-        } = self;
-        let (Some(local), Some(named)) = (local.named(), poses.named()) else {
-            unreachable!("the layouts of a route always name themselves (a test checks them)");
-        };
-        sink.run_named(NamedCall {
-            local,
-            poses: named,
-            predicted: poses.named_predicted(),
-            active,
-            method,
-            rounding,
-            backend,
-            fused,
-        });
+    pub fn run_lanes(self, backend: Backend, fused: bool) {
+        self.run_jobs::<false>(backend, fused);
     }
 
-    /// Runs in lanes on `backend` (`fused` lets the lanes fuse multiply-adds).
+    /// Runs in the scalar reference's lanes: what the AoS route takes on the scalar backend
+    /// ([`AosCall::run`]), the one backend it takes the lane loop on, so that the AoS
+    /// route compiles no other lane type's loops.
+    #[inline(always)]
+    pub fn run_scalar(self) {
+        self.run_jobs::<true>(Backend::Scalar, false);
+    }
+
+    /// Runs in lanes, on the scalar reference's alone where `SCALAR`.
     ///
     /// The active set picks the loop before the dispatch, so that each job holds only
     /// what its loop reads: compiled beside the scattered walk, whose closures borrow the
     /// whole run, the plain loop reloaded the layouts' pointers on every span. A sink that
     /// takes every object ([`Sink::EVERY`]) compiles only that loop.
     #[inline(always)]
-    pub fn run_lanes(self, backend: Backend, fused: bool) {
+    fn run_jobs<const SCALAR: bool>(self, backend: Backend, fused: bool) {
         if S::EVERY {
             debug_assert_eq!(self.active, Active::All);
-            return Self::dispatch(backend, fused, EveryInLanes(self.split().1));
+            return Self::dispatch::<SCALAR, _>(backend, fused, EveryInLanes(self.split().1));
         }
         match self.split() {
-            (Active::All, run) => Self::dispatch(backend, fused, EveryInLanes(run)),
+            (Active::All, run) => Self::dispatch::<SCALAR, _>(backend, fused, EveryInLanes(run)),
             // A dense list runs as a mask, in lanes; a sparse one an entry at a time, in one
             // lane, where spans of the lane width would rarely hold two of its objects.
             // So the lane loop compiles no walk that builds spans from a list: that walk
@@ -309,7 +284,7 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
             // one `update` on AoSoA blocks; more for a `Swept` update).
             (Active::Indices(ix), run) if dense(ix.len(), run.len) => {
                 let words = mask_of(ix, run.len);
-                Self::dispatch(
+                Self::dispatch::<SCALAR, _>(
                     backend,
                     fused,
                     SubsetInLanes {
@@ -319,9 +294,9 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
                 )
             }
             (Active::Indices(ix), run) => {
-                Self::dispatch(backend, fused, SubsetInLanes { run, set: List(ix) })
+                Self::dispatch::<SCALAR, _>(backend, fused, SubsetInLanes { run, set: List(ix) })
             }
-            (Active::Mask(words), run) => Self::dispatch(
+            (Active::Mask(words), run) => Self::dispatch::<SCALAR, _>(
                 backend,
                 fused,
                 SubsetInLanes {
@@ -332,23 +307,13 @@ impl<'a, const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: Sink<N>> Engine<'
         }
     }
 
-    /// The route of this run: the one its boxes, poses and output all name.
-    pub(crate) const ROUTE: Route = Route::of(B::ROUTE, P::ROUTE, S::ROUTE);
-    /// No route: the lane loop, compiled here.
-    pub(crate) const GENERIC: bool = matches!(Self::ROUTE, Route::Generic);
-    /// AoS 3D boxes in and out with AoS or shared poses, which the lane loop runs only on
-    /// the scalar backend ([`AosCall::run`]).
-    pub(crate) const AOS: bool = matches!(Self::ROUTE, Route::Aos);
-
-    /// [`simd::dispatch`], or straight to the scalar reference's lanes: where
-    /// [`Self::AOS`], the one backend those layouts take the lane loop on (these runs are
-    /// compiled once in bvkit for every class, beside the AoS loop); and for poses without
-    /// a lane form ([`PoseSource::LANES`]), whose lanes would only be computed one at a
-    /// time (a `LargeWorld` update's call site compiled four lane types' loops for that).
+    /// [`simd::dispatch`], or straight to the scalar reference's lanes: where `SCALAR`
+    /// ([`Engine::run_scalar`]); and for poses without a lane form
+    /// ([`PoseSource::LANES`]), whose lanes would only be computed one at a time (a
+    /// `LargeWorld` update's call site compiled four lane types' loops for that).
     #[inline(always)]
-    fn dispatch<J: Job>(backend: Backend, fused: bool, job: J) {
-        if Self::AOS || !P::LANES {
-            debug_assert!(!Self::AOS || backend == Backend::Scalar);
+    fn dispatch<const SCALAR: bool, J: Job>(backend: Backend, fused: bool, job: J) {
+        if SCALAR || !P::LANES {
             job.run::<f32>();
         } else {
             simd::dispatch(backend, fused, job);

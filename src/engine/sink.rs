@@ -3,12 +3,12 @@
 //! records their objects (the broadphase update). The lane loop takes any [`Sink`]; the AoS
 //! loop takes the two as one [`AosSink`].
 
-use super::{CHUNK, Extended, LaneSink, NamedCall, PoseSource};
+use super::{CHUNK, Extended, PoseSource};
 use crate::aabb::Aabb3;
 use crate::fat::{Margin, Moved};
 use crate::kernel::gather;
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, NamedBoxesMut, Route};
+use crate::layout::{BoxSink, BoxSource};
 use crate::simd::{self, BoxGroup, LaneArray};
 
 /// Where the lane loop's tight boxes go.
@@ -36,13 +36,6 @@ pub(crate) trait Sink<const N: usize> {
     /// batch transform's does: its runs then compile only that walk (a third of the loops
     /// otherwise).
     const EVERY: bool = false;
-    /// The run of this sink's output that bvkit compiles once, if any.
-    const ROUTE: Route = Route::Generic;
-    /// The run `call` into this sink, on its [`Route`] (not [`Route::Generic`]): the sink
-    /// by name handed to the route's function ([`NamedCall::aos`], [`NamedCall::blocks`],
-    /// [`NamedCall::soa`], [`NamedCall::aos2`]), which bvkit compiles once, so that a
-    /// generic call site compiles none of it.
-    fn run_named(self, call: NamedCall<'_>);
     /// The same sink, as the loop writes it.
     type Trimmed: Sink<N>;
     /// The sink for the first `len` objects, every slice cut to that length (see
@@ -96,17 +89,6 @@ impl<const N: usize, O: BoxSink<N>> Sink<N> for Store<O> {
         }
     }
     const EVERY: bool = true;
-    const ROUTE: Route = O::ROUTE;
-    fn run_named(mut self, call: NamedCall<'_>) {
-        let stream = self.stream;
-        match self.out.named_mut() {
-            Some(NamedBoxesMut::Aos(out)) => call.aos(AosSink::Store(out)),
-            Some(NamedBoxesMut::Blocks(out)) => call.blocks(LaneSink::Store(Store { out, stream })),
-            Some(NamedBoxesMut::Soa(out)) => call.soa(Store { out, stream }),
-            Some(NamedBoxesMut::Aos2(out)) => call.aos2(Store { out, stream }),
-            None => unreachable!("the layouts of a route always name themselves (tested)"),
-        }
-    }
     type Trimmed = Store<O::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Store<O::Trimmed> {
@@ -167,27 +149,6 @@ impl<'a, const N: usize, F: BoxSink<N>> Sink<N> for Fat<'a, F> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         self.fat.read().prefetch(i);
-    }
-    /// Columns of boxes and 2D boxes have a route in a transform only ([`NamedCall::soa`],
-    /// [`NamedCall::aos2`]).
-    const ROUTE: Route = match F::ROUTE {
-        Route::Soa | Route::Aos2 => Route::Generic,
-        route => route,
-    };
-    fn run_named(mut self, call: NamedCall<'_>) {
-        let (margin, moved) = (self.margin, self.moved);
-        match self.fat.named_mut() {
-            Some(NamedBoxesMut::Aos(fat)) => {
-                let mut scratch = [Aabb3::EMPTY; CHUNK];
-                call.aos(AosSink::Fat(Fat { fat, margin, moved }, &mut scratch));
-            }
-            Some(NamedBoxesMut::Blocks(fat)) => {
-                call.blocks(LaneSink::Fat(Fat { fat, margin, moved }));
-            }
-            Some(NamedBoxesMut::Soa(_) | NamedBoxesMut::Aos2(_)) | None => {
-                unreachable!("the layouts of an update's route always name themselves (tested)")
-            }
-        }
     }
     type Trimmed = Fat<'a, F::Trimmed>;
     #[inline(always)]

@@ -6,7 +6,7 @@
 //! width, has no mask at all.
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{Maps, NamedBoxes, NamedBoxesMut, Route, box_lanes, zero_fields};
+use super::{Maps, NamedBoxes, NamedBoxesMut, NamedPoses, Route, box_lanes, zero_fields};
 use crate::aabb::Boxes;
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -149,8 +149,8 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[T] {
         self[i]
     }
     const ROUTE: Route = if T::RIGID2 { Route::Aos2 } else { Route::Aos };
-    fn maps(&self) -> Option<Maps<'_, T>> {
-        Some(Maps::Each(self))
+    fn named(&self) -> Option<NamedPoses<'_>> {
+        T::named(Maps::Each(self))
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -182,8 +182,8 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &T {
         **self
     }
     const ROUTE: Route = Route::Aos;
-    fn maps(&self) -> Option<Maps<'_, T>> {
-        Some(Maps::Shared(self))
+    fn named(&self) -> Option<NamedPoses<'_>> {
+        T::named(Maps::Shared(self))
     }
     type Trimmed = Self;
     #[inline(always)]
@@ -276,8 +276,8 @@ impl<'a, const N: usize, E: Class<N>> TransformSource<N> for &'a Vec<E> {
         TransformSource::get(&self.as_slice(), i)
     }
     const ROUTE: Route = if E::RIGID2 { Route::Aos2 } else { Route::Aos };
-    fn maps(&self) -> Option<Maps<'_, Self::Class>> {
-        Some(Maps::Each(self.as_slice()))
+    fn named(&self) -> Option<NamedPoses<'_>> {
+        E::named(Maps::Each(self.as_slice()))
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {

@@ -10,7 +10,7 @@ use glam::{Affine2, Affine3A};
 pub use crate::fields::Block8;
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{NamedBoxes, NamedBoxesMut, Route, box_lanes, zero_fields};
+use super::{NamedBoxes, NamedBoxesMut, NamedPoses, Route, box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -213,8 +213,8 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[Block8<T>] {
     } else {
         Route::Generic
     };
-    fn rigid3x8s(&self) -> Option<&[Rigid3x8]> {
-        T::rigid3x8s(self)
+    fn named(&self) -> Option<NamedPoses<'_>> {
+        T::rigid3x8s(self).map(NamedPoses::Blocks)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -337,8 +337,8 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &Vec<Block8<T>> {
     } else {
         Route::Generic
     };
-    fn rigid3x8s(&self) -> Option<&[Rigid3x8]> {
-        T::rigid3x8s(self)
+    fn named(&self) -> Option<NamedPoses<'_>> {
+        T::rigid3x8s(self).map(NamedPoses::Blocks)
     }
     type Trimmed = Self;
     #[inline(always)]

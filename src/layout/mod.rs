@@ -10,7 +10,7 @@ use crate::aabb::{Aabb2, Aabb3};
 use crate::error::BatchError;
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::{Class, Maps};
+use crate::transform::{Class, Maps, NamedPoses};
 
 pub use aosoa::{
     Aabb2x8, Aabb3x8, Affine2x8, Affine3x8, Block8, Rigid2x8, Rigid3x8, Similarity3x8,
@@ -205,25 +205,13 @@ pub trait TransformSource<const N: usize> {
     /// Transform `i`, for the extended path.
     #[doc(hidden)]
     fn get(&self, i: usize) -> Self::Class;
-    /// The run of these transforms that bvkit compiles once, if any:
-    /// [`TransformSource::maps`] returns them on [`Route::Aos`] (by name where the class
-    /// is 3D) and [`Route::Aos2`], [`TransformSource::rigid3x8s`] on [`Route::Blocks`] and
-    /// [`TransformSource::rigid3_columns`] on [`Route::Soa`].
+    /// The run of these transforms that bvkit compiles once, if any;
+    /// [`TransformSource::named`] returns them where it is not [`Route::Generic`].
     #[doc(hidden)]
     const ROUTE: Route = Route::Generic;
-    /// The transforms as an AoS slice or one shared transform, when they are.
+    /// The transforms by name.
     #[doc(hidden)]
-    fn maps(&self) -> Option<Maps<'_, Self::Class>> {
-        None
-    }
-    /// The transforms as blocks of rigid poses, when they are.
-    #[doc(hidden)]
-    fn rigid3x8s(&self) -> Option<&[Rigid3x8]> {
-        None
-    }
-    /// The transforms as columns of rigid poses, when they are.
-    #[doc(hidden)]
-    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         None
     }
     /// Asks for transform `i`'s cache lines ahead of a scattered access.

@@ -4,7 +4,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::{BoxSink, BoxSource, NamedBoxes, NamedBoxesMut, Route, TransformSource};
+use super::{BoxSink, BoxSource, NamedBoxes, NamedBoxesMut, NamedPoses, Route, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -418,7 +418,7 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
     } else {
         Route::Generic
     };
-    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         rigid3_columns(T::RIGID3, self.columns.as_ref())
     }
 }
@@ -529,7 +529,7 @@ where
         TransformSource::prefetch(&self.view(), i);
     }
     const ROUTE: Route = <SoaRef<'a, E> as TransformSource<N>>::ROUTE;
-    fn rigid3_columns(&self) -> Option<Rigid3SoaRef<'_>> {
+    fn named(&self) -> Option<NamedPoses<'_>> {
         rigid3_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
     }
 }
@@ -553,7 +553,7 @@ fn box_columns_mut<C: AsMut<[f32]>>(aabb3: bool, columns: &mut [C]) -> Option<Na
 
 /// The columns of rigid poses by name ([`Route::Soa`]), where `rigid3` (the poses are
 /// [`Rigid3`]s, seven columns).
-fn rigid3_columns<C: AsRef<[f32]>>(rigid3: bool, columns: &[C]) -> Option<Rigid3SoaRef<'_>> {
+fn rigid3_columns<C: AsRef<[f32]>>(rigid3: bool, columns: &[C]) -> Option<NamedPoses<'_>> {
     let columns = <&[C; 7]>::try_from(columns).ok().filter(|_| rigid3)?;
-    Some(SoaRef::new(columns.each_ref().map(AsRef::as_ref)))
+    Some(NamedPoses::Soa(columns.each_ref().map(AsRef::as_ref)))
 }

@@ -14,7 +14,7 @@ use crate::kernel::MapKernel;
 use crate::lane::Axes;
 use crate::method::Method;
 
-pub(crate) use sealed::{Class, Maps, NamedPoses};
+pub(crate) use sealed::{AosPoses, Class, Maps, NamedPoses};
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -130,12 +130,24 @@ pub(crate) mod sealed {
         }
     }
 
-    /// AoS or shared poses of a 3D class, blocks or columns of rigid poses, or a slice of 2D
-    /// rigid poses, by name: how generic
-    /// code reaches the runs bvkit compiles once (`layout::Route`), so that a caller's crate
-    /// compiles a call rather than the loops.
+    /// Poses by name, one variant per route that takes poses (`engine::route`): how generic
+    /// code reaches the runs bvkit compiles once, so that a caller's crate compiles a call
+    /// rather than the loops.
     #[derive(Clone, Copy)]
     pub enum NamedPoses<'a> {
+        /// AoS or shared poses of a 3D class.
+        Aos(AosPoses<'a>),
+        /// Blocks of [`Rigid3`] poses (`Rigid3x8`).
+        Blocks(&'a [Block8<Rigid3>]),
+        /// Columns of [`Rigid3`] poses (`Rigid3SoaRef`'s), one per field.
+        Soa([&'a [f32]; 7]),
+        /// An AoS slice of [`Rigid2`] poses.
+        Aos2(&'a [Rigid2]),
+    }
+
+    /// AoS or shared poses of a 3D class, by name: the poses of the AoS route.
+    #[derive(Clone, Copy)]
+    pub enum AosPoses<'a> {
         /// [`Translation3`] poses.
         Translation3(Maps<'a, Translation3>),
         /// [`Rigid3`] poses.
@@ -146,12 +158,6 @@ pub(crate) mod sealed {
         Trs3(Maps<'a, Trs3>),
         /// `Affine3A` poses.
         Affine3A(Maps<'a, glam::Affine3A>),
-        /// Blocks of [`Rigid3`] poses (`Rigid3x8`).
-        Rigid3x8(&'a [Block8<Rigid3>]),
-        /// Columns of [`Rigid3`] poses (`Rigid3SoaRef`'s), one per field.
-        Rigid3Soa([&'a [f32]; 7]),
-        /// An AoS slice of [`Rigid2`] poses.
-        Rigid2(&'a [Rigid2]),
     }
 
     /// A transform class in `N` dimensions.

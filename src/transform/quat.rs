@@ -7,7 +7,7 @@
 
 use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
-use super::{Class, Maps, NamedPoses, Transform3};
+use super::{AosPoses, Class, Maps, NamedPoses, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Block8, Fields, MAX_FIELDS, vector_at};
 use crate::kernel::MapKernel;
@@ -377,7 +377,7 @@ impl Fields for Trs3 {
 
 impl Class<3> for Rigid3 {
     fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Rigid3(poses))
+        Some(NamedPoses::Aos(AosPoses::Rigid3(poses)))
     }
     const RIGID3: bool = true;
     fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]> {
@@ -398,7 +398,7 @@ impl Class<3> for Rigid3 {
 
 impl Class<3> for Similarity3 {
     fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Similarity3(poses))
+        Some(NamedPoses::Aos(AosPoses::Similarity3(poses)))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
@@ -416,7 +416,7 @@ impl Class<3> for Similarity3 {
 
 impl Class<3> for Trs3 {
     fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Trs3(poses))
+        Some(NamedPoses::Aos(AosPoses::Trs3(poses)))
     }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]

@@ -166,7 +166,7 @@ impl Class<2> for Rigid2 {
     const RIGID2: bool = true;
     fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
         match poses {
-            Maps::Each(poses) => Some(NamedPoses::Rigid2(poses)),
+            Maps::Each(poses) => Some(NamedPoses::Aos2(poses)),
             Maps::Shared(_) => None,
         }
     }
