@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3A};
 
-use crate::fields::{Block8, Fields, MAX_FIELDS};
+use crate::fields::{Fields, MAX_FIELDS};
 
 /// An axis-aligned box in 3D, `min <= p <= max`.
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -222,61 +222,6 @@ impl Fields for Aabb2 {
 
 /// A box type of `N` dimensions: its fields are `min` then `max`. The two are [`Aabb3`]
 /// and [`Aabb2`].
-pub(crate) trait Boxes<const N: usize>: Fields {
-    /// True when this is [`Aabb3`], whose slices and blocks the hooks below return: the
-    /// boxes of the runs bvkit compiles once (`layout::Route`); false for [`Aabb2`].
-    const AABB3: bool = false;
-    /// The slice as 2D boxes, when it is one.
-    fn aabb2s(items: &[Self]) -> Option<&[Aabb2]> {
-        let _ = items;
-        None
-    }
-    /// The mutable slice as 2D boxes, when it is one.
-    fn aabb2s_mut(items: &mut [Self]) -> Option<&mut [Aabb2]> {
-        let _ = items;
-        None
-    }
-    /// The slice as 3D boxes, when it is one.
-    fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
-        let _ = items;
-        None
-    }
-    /// The mutable slice as 3D boxes, when it is one.
-    fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
-        let _ = items;
-        None
-    }
-    /// The blocks as blocks of 3D boxes, when they are.
-    fn aabb3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Aabb3>]> {
-        let _ = blocks;
-        None
-    }
-    /// The mutable blocks as blocks of 3D boxes, when they are.
-    fn aabb3x8s_mut(blocks: &mut [Block8<Self>]) -> Option<&mut [Block8<Aabb3>]> {
-        let _ = blocks;
-        None
-    }
-}
-impl Boxes<3> for Aabb3 {
-    const AABB3: bool = true;
-    fn aabb3s(items: &[Self]) -> Option<&[Aabb3]> {
-        Some(items)
-    }
-    fn aabb3s_mut(items: &mut [Self]) -> Option<&mut [Aabb3]> {
-        Some(items)
-    }
-    fn aabb3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Aabb3>]> {
-        Some(blocks)
-    }
-    fn aabb3x8s_mut(blocks: &mut [Block8<Self>]) -> Option<&mut [Block8<Aabb3>]> {
-        Some(blocks)
-    }
-}
-impl Boxes<2> for Aabb2 {
-    fn aabb2s(items: &[Self]) -> Option<&[Aabb2]> {
-        Some(items)
-    }
-    fn aabb2s_mut(items: &mut [Self]) -> Option<&mut [Aabb2]> {
-        Some(items)
-    }
-}
+pub(crate) trait Boxes<const N: usize>: Fields {}
+impl Boxes<3> for Aabb3 {}
+impl Boxes<2> for Aabb2 {}

@@ -145,9 +145,10 @@ mod tests {
     use crate::aabb::{Aabb2, Aabb3};
     use crate::engine::{Active, Engine, Fat, NamedSink, SinkRoute, Store};
     use crate::fat::{Margin, Moved};
-    use crate::layout::{Aabb3x8, Block8, NamedBoxes, NamedBoxesMut, Route, Soa, TransformSource};
+    use crate::layout::{
+        Aabb3x8, Block8, NamedBoxes, NamedBoxesMut, NamedPoses, Route, Soa, TransformSource,
+    };
     use crate::simd::{F32s, LaneArray};
-    use crate::transform::NamedPoses;
     use crate::transform::{Rigid2, Rigid3, Similarity3, Translation2, Translation3, Trs3};
     use alloc::{vec, vec::Vec};
     use glam::{Affine3A, Quat, Vec3, Vec3A};
@@ -234,7 +235,7 @@ mod tests {
             }
         );
         let predicted = xf.named_predicted();
-        let (local, poses) = (local.named(), xf.named());
+        let (local, poses) = (local.named_boxes(), xf.named_poses());
         let mut moved = Moved::new();
         let mut fat = Fat {
             fat: out,

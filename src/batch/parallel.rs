@@ -16,10 +16,9 @@ use crate::engine::{Active, PoseSource, window};
 use crate::error::BatchError;
 use crate::fat::{Margin, Moved};
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, NamedBoxes, Route};
+use crate::layout::{BoxSink, BoxSource, Named, NamedBoxes, NamedPoses, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::LaneArray;
-use crate::transform::NamedPoses;
 
 /// The fewest boxes a part gets: below this the pool's overhead outweighs the work.
 const MIN_PART: usize = 4096;
@@ -48,24 +47,38 @@ impl<const N: usize, S: BoxSource<N>> BoxSource<N> for Window<'_, S> {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         self.src.get(self.start + i)
     }
-    // Only AoS windows keep their route; `named` takes the window's range from the source
-    // with a checked `get`, `None` (the generic route) should it not lie inside.
-    const ROUTE: Route = match S::ROUTE {
-        Route::Aos => Route::Aos,
-        _ => Route::Generic,
-    };
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        match self.src.named()? {
-            NamedBoxes::Aos(boxes) => Some(NamedBoxes::Aos(
-                boxes.get(self.start..self.start + self.len)?,
-            )),
-            NamedBoxes::Blocks(_) | NamedBoxes::Soa(_) | NamedBoxes::Aos2(_) => None,
-        }
-    }
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, _: usize) -> Self {
         self
+    }
+}
+
+/// A window keeps the AoS routes (its boxes or poses AoS, or a `Swept` pair of AoS poses):
+/// its items by name are the source's, cut to the window with a checked `get` (the window
+/// always lies inside: its range was split from the source's checked length).
+impl<S: Named> Named for Window<'_, S> {
+    const ROUTE: Route = match S::ROUTE {
+        Route::Aos => Route::Aos,
+        Route::Swept => Route::Swept,
+        _ => Route::Generic,
+    };
+    #[inline(always)]
+    fn named_boxes(&self) -> Option<NamedBoxes<'_>> {
+        match self.src.named_boxes()? {
+            NamedBoxes::Aos(boxes) => Some(NamedBoxes::Aos(
+                boxes.get(self.start..self.start.checked_add(self.len)?)?,
+            )),
+            NamedBoxes::Blocks(_) | NamedBoxes::Soa(_) | NamedBoxes::Aos2(_) => None,
+        }
+    }
+    #[inline(always)]
+    fn named_poses(&self) -> Option<NamedPoses<'_>> {
+        self.window(self.src.named_poses()?)
+    }
+    #[inline(always)]
+    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
+        self.window(self.src.named_predicted()?)
     }
 }
 
@@ -112,17 +125,6 @@ impl<const N: usize, S: PoseSource<N>> PoseSource<N> for Window<'_, S> {
         self.src.prefetch(self.start + i);
     }
     const LANES: bool = S::LANES;
-    const ROUTE: Route = match S::ROUTE {
-        Route::Aos => Route::Aos,
-        Route::Swept => Route::Swept,
-        _ => Route::Generic,
-    };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        self.window(self.src.named()?)
-    }
-    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
-        self.window(self.src.named_predicted()?)
-    }
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, _: usize) -> Self {

@@ -10,10 +10,9 @@ use crate::engine::{Active, Engine, Fat, PoseSource};
 use crate::error::BatchError;
 use crate::fat::{Margin, Moved};
 use crate::lane::Vector;
-use crate::layout::{BoxSink, BoxSource, Route};
+use crate::layout::{BoxSink, BoxSource, Named, NamedPoses, Route};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, LaneArray};
-use crate::transform::NamedPoses;
 
 use glam::DVec3;
 
@@ -47,30 +46,35 @@ pub struct LargeWorld<'a, T> {
     pub origin: DVec3,
 }
 
+/// Two sets of AoS or shared poses of 3D classes take the AoS loop at each pose, in code
+/// compiled once in bvkit (with AoS 3D boxes); any other pair the lane loop.
+impl<A: Named, B: Named> Named for Swept<A, B> {
+    const ROUTE: Route = match (A::ROUTE, B::ROUTE) {
+        (Route::Aos, Route::Aos) => Route::Swept,
+        _ => Route::Generic,
+    };
+    #[inline(always)]
+    fn named_poses(&self) -> Option<NamedPoses<'_>> {
+        match Self::ROUTE {
+            Route::Swept => self.current.named_poses(),
+            _ => None,
+        }
+    }
+    #[inline(always)]
+    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
+        match Self::ROUTE {
+            Route::Swept => self.predicted.named_poses(),
+            _ => None,
+        }
+    }
+}
+
 impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept<A, B> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
         self.current.check_len(len)?;
         self.predicted.check_len(len)
     }
     const LANES: bool = A::LANES && B::LANES;
-    /// Two sets of AoS or shared poses of 3D classes take the AoS loop at each pose, in
-    /// code compiled once in bvkit (with AoS 3D boxes); any other pair the lane loop.
-    const ROUTE: Route = match (A::ROUTE, B::ROUTE) {
-        (Route::Aos, Route::Aos) => Route::Swept,
-        _ => Route::Generic,
-    };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        match Self::ROUTE {
-            Route::Swept => self.current.named(),
-            _ => None,
-        }
-    }
-    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
-        match Self::ROUTE {
-            Route::Swept => self.predicted.named(),
-            _ => None,
-        }
-    }
     type Trimmed = Swept<A::Trimmed, B::Trimmed>;
     #[inline(always)]
     fn trim(self, len: usize) -> Self::Trimmed {
@@ -124,6 +128,9 @@ impl<const N: usize, A: PoseSource<N>, B: PoseSource<N>> PoseSource<N> for Swept
         ]
     }
 }
+
+/// Large-world poses take no route: their lanes are computed one at a time.
+impl<T> Named for LargeWorld<'_, T> {}
 
 impl<T: LargePose> PoseSource<3> for LargeWorld<'_, T> {
     fn check_len(&self, len: usize) -> Result<(), BatchError> {
@@ -314,6 +321,9 @@ mod tests {
         fat: F,
         written: &'w Cell<u64>,
     }
+
+    /// A spy takes no route: the lane loop, with every write seen.
+    impl<F> Named for Spy<'_, F> {}
 
     impl<const N: usize, F: BoxSink<N>> BoxSink<N> for Spy<'_, F> {
         fn len(&mut self) -> Result<usize, BatchError> {

@@ -16,9 +16,10 @@ use super::active::{self, List, Lookahead, Mask, Span, SpanWidth, Subset, Upcomi
 use super::{Active, AosSink, Engine, PoseSource, Sink, Store};
 use crate::aabb::Aabb3;
 use crate::kernel::{MapKernel, gather};
+use crate::layout::{AosPoses, Maps};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, BoxGroup, GroupJob};
-use crate::transform::{AosPoses, Maps, Rigid3, Similarity3, Transform3, Translation3, Trs3};
+use crate::transform::{Rigid3, Similarity3, Transform3, Translation3, Trs3};
 
 /// The objects of a span of a mask's walk ([`active::walk`]): a mask word's worth, whole
 /// words that follow each other run several boxes per vector (`docs/decisions.md`, "The

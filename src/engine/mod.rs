@@ -68,10 +68,10 @@ use crate::error::BatchError;
 use crate::extended;
 use crate::kernel;
 use crate::lane::Vector;
-use crate::layout::{BoxSource, Route, TransformSource};
+use crate::layout::{BoxSource, Named, TransformSource};
 use crate::method::{Method, Rounding};
 use crate::simd::{self, Backend, Job, LaneArray};
-use crate::transform::{Class, NamedPoses};
+use crate::transform::Class;
 
 /// The poses a batch reads, for [`Batch::transform`](crate::Batch::transform) and
 /// [`Batch::update`](crate::Batch::update) alike: transforms
@@ -79,7 +79,7 @@ use crate::transform::{Class, NamedPoses};
 /// `&T`), a [`Swept`](crate::Swept) pair of them, or [`LargeWorld`](crate::LargeWorld)
 /// poses. Sealed, as
 /// [`BoxSource`].
-pub trait PoseSource<const N: usize> {
+pub trait PoseSource<const N: usize>: Named {
     #[doc(hidden)]
     /// Refuses a pose count other than `len` (a shared pose has none).
     fn check_len(&self, len: usize) -> Result<(), BatchError>;
@@ -117,20 +117,6 @@ pub trait PoseSource<const N: usize> {
     /// own): the run then takes lanes of one on every backend, the scalar reference's, and
     /// compiles no other.
     const LANES: bool = true;
-    #[doc(hidden)]
-    /// The run of these poses that bvkit compiles once, if any; [`PoseSource::named`]
-    /// returns them where it is not [`Route::Generic`] (and their class is 3D).
-    const ROUTE: Route = Route::Generic;
-    #[doc(hidden)]
-    /// The poses by name (a [`Swept`](crate::Swept) pair's current ones): see [`route`].
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        None
-    }
-    #[doc(hidden)]
-    /// A [`Swept`](crate::Swept) pair's predicted poses by name, on [`Route::Swept`].
-    fn named_predicted(&self) -> Option<NamedPoses<'_>> {
-        None
-    }
     #[doc(hidden)]
     /// The same poses, as the loop reads them.
     type Trimmed: PoseSource<N> + Clone;
@@ -178,11 +164,6 @@ impl<const N: usize, X: TransformSource<N>> PoseSource<N> for X {
     #[inline(always)]
     fn trim(self, len: usize) -> X::Trimmed {
         TransformSource::trim(self, len)
-    }
-    const ROUTE: Route = X::ROUTE;
-    #[inline(always)]
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        TransformSource::named(self)
     }
 }
 

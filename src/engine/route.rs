@@ -17,12 +17,12 @@ use super::{Active, AosCall, AosSink, CHUNK, Engine, Fat, PoseSource, Sink, Stor
 use crate::aabb::{Aabb2, Aabb3};
 use crate::fat::{Margin, Moved};
 use crate::layout::{
-    Aabb3x8, AabbSoaMut, AabbSoaRef, BoxSink, BoxSource, NamedBoxes, NamedBoxesMut, Rigid3SoaRef,
-    Rigid3x8, Route,
+    Aabb3x8, AabbSoaMut, AabbSoaRef, AosPoses, BoxSink, BoxSource, NamedBoxes, NamedBoxesMut,
+    NamedPoses, Rigid3SoaRef, Rigid3x8, Route,
 };
 use crate::method::{Method, Rounding};
 use crate::simd::Backend;
-use crate::transform::{AosPoses, NamedPoses, Rigid2};
+use crate::transform::Rigid2;
 
 /// A sink by name: its output, and what it does with the tight boxes.
 pub(crate) enum NamedSink<'s> {
@@ -58,7 +58,7 @@ impl<const N: usize, O: BoxSink<N>> SinkRoute<N> for Store<O> {
     fn named(&mut self) -> Option<NamedSink<'_>> {
         let stream = self.stream;
         Some(NamedSink::Store {
-            out: self.out.named_mut()?,
+            out: self.out.named_boxes_mut()?,
             stream,
         })
     }
@@ -75,7 +75,7 @@ impl<const N: usize, F: BoxSink<N>> SinkRoute<N> for Fat<'_, F> {
     #[inline(always)]
     fn named(&mut self) -> Option<NamedSink<'_>> {
         Some(NamedSink::Fat {
-            fat: self.fat.named_mut()?,
+            fat: self.fat.named_boxes_mut()?,
             margin: self.margin,
             moved: &mut *self.moved,
         })
@@ -111,7 +111,7 @@ impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: SinkRoute<N>> Engine<
             fused,
         };
         let predicted = poses.named_predicted();
-        match (local.named(), poses.named(), sink.named()) {
+        match (local.named_boxes(), poses.named_poses(), sink.named()) {
             (Some(NamedBoxes::Aos(local)), Some(NamedPoses::Aos(poses)), Some(sink)) => {
                 let predicted = match predicted {
                     None => None,
@@ -163,7 +163,7 @@ impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: SinkRoute<N>> Engine<
                     out: NamedBoxesMut::Soa(out),
                     stream,
                 }),
-            ) => soa(call, local, poses, Store { out, stream }),
+            ) => soa(call, local, poses, out, stream),
             (
                 Some(NamedBoxes::Aos2(local)),
                 Some(NamedPoses::Aos2(poses)),
@@ -280,12 +280,17 @@ fn blocks(call: RouteCall<'_>, local: &[Aabb3x8], poses: &[Rigid3x8], sink: Bloc
 #[inline(never)]
 fn soa(
     call: RouteCall<'_>,
-    local: AabbSoaRef<'_>,
+    local: [&[f32]; 6],
     poses: [&[f32]; 7],
-    sink: Store<AabbSoaMut<'_>>,
+    out: [&mut [f32]; 6],
+    stream: bool,
 ) {
-    let len = local.columns[0].len();
-    call.lane_loop(local, Rigid3SoaRef::new(poses), len, sink);
+    let len = local[0].len();
+    let sink = Store {
+        out: AabbSoaMut::new(out),
+        stream,
+    };
+    call.lane_loop(AabbSoaRef::new(local), Rigid3SoaRef::new(poses), len, sink);
 }
 
 /// [`Route::Aos2`]: the lane loop over AoS 2D boxes and rigid poses, on every backend, in a

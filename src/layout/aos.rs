@@ -6,7 +6,7 @@
 //! width, has no mask at all.
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{Maps, NamedBoxes, NamedBoxesMut, NamedPoses, Route, box_lanes, zero_fields};
+use super::{NamedItem, box_lanes, zero_fields};
 use crate::aabb::Boxes;
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -30,29 +30,7 @@ fn gather<L: LaneArray, T: Fields>(items: &[T], i: usize, count: usize) -> [L; M
     f
 }
 
-/// The route of AoS boxes: [`Route::Aos`] in 3D, [`Route::Aos2`] in 2D (the two box types).
-const fn aos_route(aabb3: bool) -> Route {
-    if aabb3 { Route::Aos } else { Route::Aos2 }
-}
-
-/// AoS boxes by name.
-fn named<const N: usize, B: Boxes<N>>(boxes: &[B]) -> Option<NamedBoxes<'_>> {
-    match B::aabb3s(boxes) {
-        Some(boxes) => Some(NamedBoxes::Aos(boxes)),
-        None => B::aabb2s(boxes).map(NamedBoxes::Aos2),
-    }
-}
-
-/// AoS boxes to write, by name.
-fn named_mut<const N: usize, B: Boxes<N>>(boxes: &mut [B]) -> Option<NamedBoxesMut<'_>> {
-    if B::AABB3 {
-        B::aabb3s_mut(boxes).map(NamedBoxesMut::Aos)
-    } else {
-        B::aabb2s_mut(boxes).map(NamedBoxesMut::Aos2)
-    }
-}
-
-impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[B] {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSource<N> for &[B] {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(<[B]>::len(self))
     }
@@ -63,10 +41,6 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[B] {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         let (lo, hi) = box_lanes::<f32, N>(&self[i].to_fields());
         (lo.0, hi.0)
-    }
-    const ROUTE: Route = aos_route(B::AABB3);
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        named(self)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -79,7 +53,7 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[B] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [B] {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSink<N> for &mut [B] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[B]>::len(self))
     }
@@ -121,10 +95,6 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [B] {
         v[N..2 * N].copy_from_slice(&max);
         self[i] = B::from_fields(&v);
     }
-    const ROUTE: Route = aos_route(B::AABB3);
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        named_mut(self)
-    }
     #[cfg(feature = "rayon")]
     type Part<'p>
         = &'p mut [B]
@@ -147,10 +117,6 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[T] {
     }
     fn get(&self, i: usize) -> T {
         self[i]
-    }
-    const ROUTE: Route = if T::RIGID2 { Route::Aos2 } else { Route::Aos };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        T::named(Maps::Each(self))
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -181,10 +147,6 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &T {
     fn get(&self, _: usize) -> T {
         **self
     }
-    const ROUTE: Route = Route::Aos;
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        T::named(Maps::Shared(self))
-    }
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, _: usize) -> Self {
@@ -192,7 +154,7 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &T {
     }
 }
 
-impl<'a, const N: usize, E: Boxes<N>> BoxSource<N> for &'a Vec<E> {
+impl<'a, const N: usize, E: Boxes<N> + NamedItem> BoxSource<N> for &'a Vec<E> {
     fn len(&self) -> Result<usize, BatchError> {
         BoxSource::len(&self.as_slice())
     }
@@ -202,10 +164,6 @@ impl<'a, const N: usize, E: Boxes<N>> BoxSource<N> for &'a Vec<E> {
     }
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         BoxSource::get(&self.as_slice(), i)
-    }
-    const ROUTE: Route = aos_route(E::AABB3);
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        named(self)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -218,7 +176,7 @@ impl<'a, const N: usize, E: Boxes<N>> BoxSource<N> for &'a Vec<E> {
     }
 }
 
-impl<'a, const N: usize, E: Boxes<N>> BoxSink<N> for &'a mut Vec<E> {
+impl<'a, const N: usize, E: Boxes<N> + NamedItem> BoxSink<N> for &'a mut Vec<E> {
     fn len(&mut self) -> Result<usize, BatchError> {
         BoxSink::len(&mut self.as_mut_slice())
     }
@@ -248,10 +206,6 @@ impl<'a, const N: usize, E: Boxes<N>> BoxSink<N> for &'a mut Vec<E> {
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]) {
         self.as_mut_slice().set(i, min, max);
     }
-    const ROUTE: Route = aos_route(E::AABB3);
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        named_mut(self)
-    }
     #[cfg(feature = "rayon")]
     type Part<'p>
         = &'p mut [E]
@@ -274,10 +228,6 @@ impl<'a, const N: usize, E: Class<N>> TransformSource<N> for &'a Vec<E> {
     }
     fn get(&self, i: usize) -> Self::Class {
         TransformSource::get(&self.as_slice(), i)
-    }
-    const ROUTE: Route = if E::RIGID2 { Route::Aos2 } else { Route::Aos };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        E::named(Maps::Each(self.as_slice()))
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {

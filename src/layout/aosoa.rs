@@ -10,7 +10,7 @@ use glam::{Affine2, Affine3A};
 pub use crate::fields::Block8;
 
 use super::{BoxSink, BoxSource, TransformSource};
-use super::{NamedBoxes, NamedBoxesMut, NamedPoses, Route, box_lanes, zero_fields};
+use super::{NamedItem, box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
 use crate::fields::{Fields, MAX_FIELDS};
@@ -63,7 +63,7 @@ pod_blocks! {
     Rigid3: 7, Similarity3: 8, Trs3: 10, Rigid2: 4,
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[Block8<B>] {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSource<N> for &[Block8<B>] {
     fn len(&self) -> Result<usize, BatchError> {
         Ok(<[Block8<B>]>::len(self) * 8)
     }
@@ -74,14 +74,6 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[Block8<B>] {
     fn get(&self, i: usize) -> ([f32; N], [f32; N]) {
         let (lo, hi) = box_lanes::<f32, N>(&self[i / 8].get(i % 8).to_fields());
         (lo.0, hi.0)
-    }
-    const ROUTE: Route = if B::AABB3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        B::aabb3x8s(self).map(NamedBoxes::Blocks)
     }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
@@ -94,17 +86,9 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &[Block8<B>] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut [Block8<B>] {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSink<N> for &mut [Block8<B>] {
     fn len(&mut self) -> Result<usize, BatchError> {
         Ok(<[Block8<B>]>::len(self) * 8)
-    }
-    const ROUTE: Route = if B::AABB3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        B::aabb3x8s_mut(self).map(NamedBoxesMut::Blocks)
     }
     type Read<'r>
         = &'r [Block8<B>]
@@ -208,14 +192,6 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[Block8<T>] {
     fn get(&self, i: usize) -> T {
         self[i / 8].get(i % 8)
     }
-    const ROUTE: Route = if T::RIGID3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        T::rigid3x8s(self).map(NamedPoses::Blocks)
-    }
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         self[i / 8].prefetch(i % 8);
@@ -227,7 +203,7 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &[Block8<T>] {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSource<N> for &Vec<Block8<B>> {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSource<N> for &Vec<Block8<B>> {
     fn len(&self) -> Result<usize, BatchError> {
         BoxSource::len(&self.as_slice())
     }
@@ -242,14 +218,6 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &Vec<Block8<B>> {
     fn prefetch(&self, i: usize) {
         BoxSource::prefetch(&self.as_slice(), i);
     }
-    const ROUTE: Route = if B::AABB3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        B::aabb3x8s(self).map(NamedBoxes::Blocks)
-    }
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, _: usize) -> Self {
@@ -257,17 +225,9 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for &Vec<Block8<B>> {
     }
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSink<N> for &mut Vec<Block8<B>> {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSink<N> for &mut Vec<Block8<B>> {
     fn len(&mut self) -> Result<usize, BatchError> {
         BoxSink::len(&mut self.as_mut_slice())
-    }
-    const ROUTE: Route = if B::AABB3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        B::aabb3x8s_mut(self).map(NamedBoxesMut::Blocks)
     }
     type Read<'r>
         = &'r [Block8<B>]
@@ -331,14 +291,6 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for &Vec<Block8<T>> {
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         TransformSource::prefetch(&self.as_slice(), i);
-    }
-    const ROUTE: Route = if T::RIGID3 {
-        Route::Blocks
-    } else {
-        Route::Generic
-    };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        T::rigid3x8s(self).map(NamedPoses::Blocks)
     }
     type Trimmed = Self;
     #[inline(always)]

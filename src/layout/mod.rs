@@ -4,13 +4,18 @@
 
 mod aos;
 mod aosoa;
+mod named;
 mod soa;
 
-use crate::aabb::{Aabb2, Aabb3};
 use crate::error::BatchError;
 use crate::lane::Vector;
 use crate::simd::LaneArray;
-use crate::transform::{Class, Maps, NamedPoses};
+use crate::transform::Class;
+
+pub use crate::transform::{
+    AosPoses, Maps, NamedBoxes, NamedBoxesMut, NamedItem, NamedPoses, Route,
+};
+pub use named::Named;
 
 pub use aosoa::{
     Aabb2x8, Aabb3x8, Affine2x8, Affine3x8, Block8, Rigid2x8, Rigid3x8, Similarity3x8,
@@ -21,72 +26,10 @@ pub use soa::{
     Rigid3Soa, Rigid3SoaRef, Soa, SoaMut, SoaRef,
 };
 
-/// Which run of a layout bvkit compiles once, in itself, so that a caller's call site
-/// compiles a call rather than the loops. A run takes the route its boxes, poses and
-/// output all name (`Engine::ROUTE`); any other runs the lane loop where it is called.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Route {
-    /// None: the lane loop, instantiated at the call site.
-    Generic,
-    /// AoS 3D boxes (`&[Aabb3]`) with AoS or shared poses of a 3D class: the AoS loop.
-    Aos,
-    /// AoSoA blocks of 3D boxes (`&[Aabb3x8]`) with blocks of rigid poses
-    /// (`&[Rigid3x8]`), the layout the README recommends for the update: the lane loop.
-    Blocks,
-    /// AoS 3D boxes with a [`Swept`](crate::Swept) pair of AoS or shared poses of 3D
-    /// classes: the AoS loop at each pose, and the union of the two boxes.
-    Swept,
-    /// SoA columns of 3D boxes with columns of rigid poses, in a transform (the plain sink):
-    /// the lane loop.
-    Soa,
-    /// AoS 2D boxes (`&[Aabb2]`) with AoS rigid 2D poses (`&[Rigid2]`), in a transform (the
-    /// plain sink): the lane loop.
-    Aos2,
-}
-
-impl Route {
-    /// The route of a run whose boxes, poses and output name `a`, `b` and `c`.
-    pub const fn of(a: Route, b: Route, c: Route) -> Route {
-        match (a, b, c) {
-            (Route::Aos, Route::Aos, Route::Aos) => Route::Aos,
-            (Route::Blocks, Route::Blocks, Route::Blocks) => Route::Blocks,
-            (Route::Aos, Route::Swept, Route::Aos) => Route::Swept,
-            (Route::Soa, Route::Soa, Route::Soa) => Route::Soa,
-            (Route::Aos2, Route::Aos2, Route::Aos2) => Route::Aos2,
-            _ => Route::Generic,
-        }
-    }
-}
-
-/// Boxes on a [`Route`], by name.
-#[derive(Clone, Copy)]
-pub enum NamedBoxes<'a> {
-    /// An AoS slice of 3D boxes.
-    Aos(&'a [Aabb3]),
-    /// AoSoA blocks.
-    Blocks(&'a [Aabb3x8]),
-    /// SoA columns.
-    Soa(AabbSoaRef<'a>),
-    /// An AoS slice of 2D boxes.
-    Aos2(&'a [Aabb2]),
-}
-
-/// Boxes to write on a [`Route`], by name.
-pub enum NamedBoxesMut<'a> {
-    /// An AoS slice of 3D boxes.
-    Aos(&'a mut [Aabb3]),
-    /// AoSoA blocks.
-    Blocks(&'a mut [Aabb3x8]),
-    /// SoA columns.
-    Soa(AabbSoaMut<'a>),
-    /// An AoS slice of 2D boxes.
-    Aos2(&'a mut [Aabb2]),
-}
-
 /// Boxes a batch reads, in some layout: see [`Batch`](crate::Batch) for the list. Sealed:
 /// its items are bvkit's own (how a layout loads lanes and single boxes), and hidden.
 #[allow(clippy::len_without_is_empty)] // hidden machinery, not a collection
-pub trait BoxSource<const N: usize> {
+pub trait BoxSource<const N: usize>: Named {
     /// The number of boxes, or an error when the layout's columns disagree.
     #[doc(hidden)]
     fn len(&self) -> Result<usize, BatchError>;
@@ -96,15 +39,6 @@ pub trait BoxSource<const N: usize> {
     /// Box `i` as `(min, max)`, for the extended path.
     #[doc(hidden)]
     fn get(&self, i: usize) -> ([f32; N], [f32; N]);
-    /// The run of these boxes that bvkit compiles once, if any; [`BoxSource::named`]
-    /// returns them where it is not [`Route::Generic`].
-    #[doc(hidden)]
-    const ROUTE: Route = Route::Generic;
-    /// The boxes by name.
-    #[doc(hidden)]
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        None
-    }
     /// Asks for box `i`'s cache lines ahead of a scattered access.
     #[doc(hidden)]
     #[inline(always)]
@@ -125,7 +59,7 @@ pub trait BoxSource<const N: usize> {
 /// Boxes a batch writes, in some layout: see [`Batch`](crate::Batch) for the list. Sealed,
 /// as [`BoxSource`].
 #[allow(clippy::len_without_is_empty)] // hidden machinery, not a collection
-pub trait BoxSink<const N: usize> {
+pub trait BoxSink<const N: usize>: Named {
     /// The number of boxes, or an error when the layout's columns disagree (`&mut`, so
     /// that a `Vec` can ask its slice).
     #[doc(hidden)]
@@ -149,15 +83,6 @@ pub trait BoxSink<const N: usize> {
     /// Writes box `i`.
     #[doc(hidden)]
     fn set(&mut self, i: usize, min: [f32; N], max: [f32; N]);
-    /// The run of these boxes that bvkit compiles once, if any; [`BoxSink::named_mut`]
-    /// returns them where it is not [`Route::Generic`].
-    #[doc(hidden)]
-    const ROUTE: Route = Route::Generic;
-    /// The boxes by name.
-    #[doc(hidden)]
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        None
-    }
     /// The same boxes as a source, for a sink that reads the boxes it may rewrite (the
     /// broadphase's fat boxes).
     #[doc(hidden)]
@@ -191,7 +116,7 @@ pub trait BoxSink<const N: usize> {
 /// [`BoundingVolume::transformed_aabbs`](crate::BoundingVolume::transformed_aabbs), which
 /// needs the transforms themselves, takes only these. Sealed, as [`BoxSource`].
 #[allow(clippy::len_without_is_empty)] // hidden machinery, not a collection
-pub trait TransformSource<const N: usize> {
+pub trait TransformSource<const N: usize>: Named {
     /// The transform class.
     #[doc(hidden)]
     type Class: Class<N>;
@@ -205,15 +130,6 @@ pub trait TransformSource<const N: usize> {
     /// Transform `i`, for the extended path.
     #[doc(hidden)]
     fn get(&self, i: usize) -> Self::Class;
-    /// The run of these transforms that bvkit compiles once, if any;
-    /// [`TransformSource::named`] returns them where it is not [`Route::Generic`].
-    #[doc(hidden)]
-    const ROUTE: Route = Route::Generic;
-    /// The transforms by name.
-    #[doc(hidden)]
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        None
-    }
     /// Asks for transform `i`'s cache lines ahead of a scattered access.
     #[doc(hidden)]
     #[inline(always)]

@@ -4,7 +4,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use glam::Affine3A;
 
-use super::{BoxSink, BoxSource, NamedBoxes, NamedBoxesMut, NamedPoses, Route, TransformSource};
+use super::{BoxSink, BoxSource, NamedItem, TransformSource};
 use super::{box_lanes, zero_fields};
 use crate::aabb::{Aabb2, Aabb3, Boxes};
 use crate::error::BatchError;
@@ -279,7 +279,7 @@ fn gather<L: LaneArray, T: Fields>(
     f
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSource<N> for SoaRef<'_, B> {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSource<N> for SoaRef<'_, B> {
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, len: usize) -> Self {
@@ -306,13 +306,9 @@ impl<const N: usize, B: Boxes<N>> BoxSource<N> for SoaRef<'_, B> {
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
-    const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        box_columns(B::AABB3, self.columns.as_ref())
-    }
 }
 
-impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
+impl<const N: usize, B: Boxes<N> + NamedItem> BoxSink<N> for SoaMut<'_, B> {
     type Trimmed = Self;
     #[inline(always)]
     fn trim(self, len: usize) -> Self {
@@ -378,10 +374,6 @@ impl<const N: usize, B: Boxes<N>> BoxSink<N> for SoaMut<'_, B> {
     fn parts(&mut self, chunk: usize) -> Vec<SoaMut<'_, B>> {
         split_columns(self.columns.as_mut().iter_mut().map(|c| &mut **c), chunk)
     }
-    const ROUTE: Route = if B::AABB3 { Route::Soa } else { Route::Generic };
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        box_columns_mut(B::AABB3, self.columns.as_mut())
-    }
 }
 
 impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
@@ -413,17 +405,9 @@ impl<const N: usize, T: Class<N>> TransformSource<N> for SoaRef<'_, T> {
     fn prefetch(&self, i: usize) {
         prefetch_columns(self.columns.as_ref(), i);
     }
-    const ROUTE: Route = if T::RIGID3 {
-        Route::Soa
-    } else {
-        Route::Generic
-    };
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        rigid3_columns(T::RIGID3, self.columns.as_ref())
-    }
 }
 
-impl<'a, const N: usize, E: Fields> BoxSource<N> for &'a Soa<E>
+impl<'a, const N: usize, E: NamedItem> BoxSource<N> for &'a Soa<E>
 where
     SoaRef<'a, E>: BoxSource<N>,
 {
@@ -446,13 +430,9 @@ where
     fn prefetch(&self, i: usize) {
         BoxSource::prefetch(&self.view(), i);
     }
-    const ROUTE: Route = <SoaRef<'a, E> as BoxSource<N>>::ROUTE;
-    fn named(&self) -> Option<NamedBoxes<'_>> {
-        box_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
-    }
 }
 
-impl<'a, const N: usize, E: Fields> BoxSink<N> for &'a mut Soa<E>
+impl<'a, const N: usize, E: NamedItem> BoxSink<N> for &'a mut Soa<E>
 where
     for<'b> SoaMut<'b, E>: BoxSink<N>,
     for<'b> SoaRef<'b, E>: BoxSource<N>,
@@ -498,13 +478,9 @@ where
             chunk,
         )
     }
-    const ROUTE: Route = <SoaMut<'a, E> as BoxSink<N>>::ROUTE;
-    fn named_mut(&mut self) -> Option<NamedBoxesMut<'_>> {
-        box_columns_mut(Self::ROUTE == Route::Soa, self.columns.as_mut())
-    }
 }
 
-impl<'a, const N: usize, E: Fields> TransformSource<N> for &'a Soa<E>
+impl<'a, const N: usize, E: NamedItem> TransformSource<N> for &'a Soa<E>
 where
     SoaRef<'a, E>: TransformSource<N>,
 {
@@ -528,32 +504,4 @@ where
     fn prefetch(&self, i: usize) {
         TransformSource::prefetch(&self.view(), i);
     }
-    const ROUTE: Route = <SoaRef<'a, E> as TransformSource<N>>::ROUTE;
-    fn named(&self) -> Option<NamedPoses<'_>> {
-        rigid3_columns(Self::ROUTE == Route::Soa, self.columns.as_ref())
-    }
-}
-
-/// The columns of 3D boxes by name ([`Route::Soa`]), where `aabb3` (the boxes are
-/// [`Aabb3`]s, six columns).
-fn box_columns<C: AsRef<[f32]>>(aabb3: bool, columns: &[C]) -> Option<NamedBoxes<'_>> {
-    let columns = <&[C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
-    Some(NamedBoxes::Soa(SoaRef::new(
-        columns.each_ref().map(AsRef::as_ref),
-    )))
-}
-
-/// [`box_columns`] to write.
-fn box_columns_mut<C: AsMut<[f32]>>(aabb3: bool, columns: &mut [C]) -> Option<NamedBoxesMut<'_>> {
-    let columns = <&mut [C; 6]>::try_from(columns).ok().filter(|_| aabb3)?;
-    Some(NamedBoxesMut::Soa(SoaMut::new(
-        columns.each_mut().map(AsMut::as_mut),
-    )))
-}
-
-/// The columns of rigid poses by name ([`Route::Soa`]), where `rigid3` (the poses are
-/// [`Rigid3`]s, seven columns).
-fn rigid3_columns<C: AsRef<[f32]>>(rigid3: bool, columns: &[C]) -> Option<NamedPoses<'_>> {
-    let columns = <&[C; 7]>::try_from(columns).ok().filter(|_| rigid3)?;
-    Some(NamedPoses::Soa(columns.each_ref().map(AsRef::as_ref)))
 }

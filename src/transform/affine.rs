@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Mat2, Mat3A, Vec2, Vec3A};
 
-use super::{AosPoses, Class, Maps, NamedPoses, Transform2, Transform3};
+use super::{Class, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::AffineLanes;
@@ -35,9 +35,6 @@ impl Fields for Affine3A {
 }
 
 impl Class<3> for Affine3A {
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Aos(AosPoses::Affine3A(poses)))
-    }
     type Lanes<L: Lane> = AffineLanes<Vector<L, 3>, 3>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {

@@ -2,6 +2,7 @@
 //! [`Transform3`]).
 
 mod affine;
+mod named;
 mod quat;
 mod rigid2;
 mod translation;
@@ -14,7 +15,8 @@ use crate::kernel::MapKernel;
 use crate::lane::Axes;
 use crate::method::Method;
 
-pub(crate) use sealed::{AosPoses, Class, Maps, NamedPoses};
+pub use named::{AosPoses, Maps, NamedBoxes, NamedBoxesMut, NamedItem, NamedPoses, Route};
+pub(crate) use sealed::Class;
 
 /// A 3D transform class: every single-box and batch entry point accepts any of them.
 ///
@@ -106,62 +108,12 @@ pub(crate) mod sealed {
 
     use super::*;
     use crate::extended::ExtendedMap;
-    use crate::fields::{Block8, Fields, MAX_FIELDS};
+    use crate::fields::{Fields, MAX_FIELDS};
     use crate::kernel::MapKernel;
     use crate::lane::{Lane, Vector};
 
-    /// Transforms read as AoS: one per box, or one shared.
-    #[derive(Clone, Copy)]
-    pub enum Maps<'a, T> {
-        /// Transform `k` for box `k`.
-        Each(&'a [T]),
-        /// One transform for every box.
-        Shared(&'a T),
-    }
-
-    impl<'a, T> Maps<'a, T> {
-        /// Box `i`'s transform.
-        #[inline(always)]
-        pub fn at(self, i: usize) -> &'a T {
-            match self {
-                Maps::Each(maps) => &maps[i],
-                Maps::Shared(map) => map,
-            }
-        }
-    }
-
-    /// Poses by name, one variant per route that takes poses (`engine::route`): how generic
-    /// code reaches the runs bvkit compiles once, so that a caller's crate compiles a call
-    /// rather than the loops.
-    #[derive(Clone, Copy)]
-    pub enum NamedPoses<'a> {
-        /// AoS or shared poses of a 3D class.
-        Aos(AosPoses<'a>),
-        /// Blocks of [`Rigid3`] poses (`Rigid3x8`).
-        Blocks(&'a [Block8<Rigid3>]),
-        /// Columns of [`Rigid3`] poses (`Rigid3SoaRef`'s), one per field.
-        Soa([&'a [f32]; 7]),
-        /// An AoS slice of [`Rigid2`] poses.
-        Aos2(&'a [Rigid2]),
-    }
-
-    /// AoS or shared poses of a 3D class, by name: the poses of the AoS route.
-    #[derive(Clone, Copy)]
-    pub enum AosPoses<'a> {
-        /// [`Translation3`] poses.
-        Translation3(Maps<'a, Translation3>),
-        /// [`Rigid3`] poses.
-        Rigid3(Maps<'a, Rigid3>),
-        /// [`Similarity3`] poses.
-        Similarity3(Maps<'a, Similarity3>),
-        /// [`Trs3`] poses.
-        Trs3(Maps<'a, Trs3>),
-        /// `Affine3A` poses.
-        Affine3A(Maps<'a, glam::Affine3A>),
-    }
-
     /// A transform class in `N` dimensions.
-    pub trait Class<const N: usize>: Fields {
+    pub trait Class<const N: usize>: Fields + NamedItem {
         /// The class in lanes (`Vector<L, N>` holds one box per lane of `L`).
         type Lanes<L: Lane>: MapKernel<Vector<L, N>>;
         /// The lanes from the fields in lanes (`f[k]` holds field `k` of every lane).
@@ -170,27 +122,5 @@ pub(crate) mod sealed {
         fn extended(&self) -> ExtendedMap<N>;
         /// The order `n` of the Nearest bound under `method`.
         fn order(method: Method) -> u32;
-        /// The poses by name: every 3D class, and a slice of [`Rigid2`].
-        fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>>
-        where
-            Self: Sized,
-        {
-            let _ = poses;
-            None
-        }
-        /// True when this is [`Rigid3`], whose blocks [`Class::rigid3x8s`] returns: the
-        /// poses of the blocks' runs that bvkit compiles once (`layout::Route`).
-        const RIGID3: bool = false;
-        /// True when this is [`Rigid2`], whose slices [`Class::named`] returns: the poses
-        /// of the 2D runs that bvkit compiles once (`layout::Route::Aos2`).
-        const RIGID2: bool = false;
-        /// The blocks as blocks of rigid poses, when they are.
-        fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]>
-        where
-            Self: Sized,
-        {
-            let _ = blocks;
-            None
-        }
     }
 }

@@ -7,9 +7,9 @@
 
 use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
-use super::{AosPoses, Class, Maps, NamedPoses, Transform3};
+use super::{Class, Transform3};
 use crate::extended::ExtendedMap;
-use crate::fields::{Block8, Fields, MAX_FIELDS, vector_at};
+use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel::MapKernel;
 use crate::kernel::{self, AffineLanes};
 use crate::lane::{Axes, Lane, Vector};
@@ -376,13 +376,6 @@ impl Fields for Trs3 {
 }
 
 impl Class<3> for Rigid3 {
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Aos(AosPoses::Rigid3(poses)))
-    }
-    const RIGID3: bool = true;
-    fn rigid3x8s(blocks: &[Block8<Self>]) -> Option<&[Block8<Rigid3>]> {
-        Some(blocks)
-    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, false>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
@@ -397,9 +390,6 @@ impl Class<3> for Rigid3 {
 }
 
 impl Class<3> for Similarity3 {
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Aos(AosPoses::Similarity3(poses)))
-    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
@@ -415,9 +405,6 @@ impl Class<3> for Similarity3 {
 }
 
 impl Class<3> for Trs3 {
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Aos(AosPoses::Trs3(poses)))
-    }
     type Lanes<L: Lane> = QuatLanes<Vector<L, 3>, true>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {

@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Mat2, Vec2};
 
-use super::{Class, Maps, NamedPoses, Transform2};
+use super::{Class, Transform2};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS};
 use crate::kernel::MapKernel;
@@ -162,13 +162,6 @@ impl Class<2> for Rigid2 {
     }
     fn order(method: Method) -> u32 {
         method.nearest_order(2)
-    }
-    const RIGID2: bool = true;
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        match poses {
-            Maps::Each(poses) => Some(NamedPoses::Aos2(poses)),
-            Maps::Shared(_) => None,
-        }
     }
 }
 

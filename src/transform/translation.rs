@@ -2,7 +2,7 @@
 
 use glam::{Affine2, Affine3A, Vec2, Vec3, Vec3A};
 
-use super::{AosPoses, Class, Maps, NamedPoses, Transform2, Transform3};
+use super::{Class, Transform2, Transform3};
 use crate::extended::ExtendedMap;
 use crate::fields::{Fields, MAX_FIELDS, vector_at};
 use crate::kernel;
@@ -119,9 +119,6 @@ impl Fields for Translation3 {
 
 /// One rounding per face: `n = 1` for every method (they coincide).
 impl Class<3> for Translation3 {
-    fn named(poses: Maps<'_, Self>) -> Option<NamedPoses<'_>> {
-        Some(NamedPoses::Aos(AosPoses::Translation3(poses)))
-    }
     type Lanes<L: Lane> = TranslationLanes<Vector<L, 3>>;
     #[inline(always)]
     fn lanes<L: Lane>(f: &[L; MAX_FIELDS]) -> Self::Lanes<L> {
