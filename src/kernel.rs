@@ -37,7 +37,8 @@ impl AffineLanes<Vec3A, 3> {
 
 /// `[f(0), …, f(W − 1)]`, always inlined: the AoS loop builds its groups with this rather
 /// than `core::array::from_fn` or `map`, which were compiled out of line, without the
-/// dispatch wrapper's features (a rigid AoS batch ran 2.5x slower).
+/// dispatch wrapper's features (`docs/decisions.md`, "The AoS loop's groups built by
+/// `gather`").
 #[inline(always)]
 pub(crate) fn gather<const W: usize, X: Copy>(mut f: impl FnMut(usize) -> X) -> [X; W] {
     let mut out = [f(0); W];

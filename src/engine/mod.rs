@@ -470,9 +470,9 @@ where
     S: Sink<N>,
 {
     /// Objects `start..end`, every one active: a plain loop over spans of the lane width,
-    /// then the tail. Over every object, walking spans measured up to
-    /// 1.5x slower on cheap kernels in cache (the per-span decoding and mask tests are not
-    /// free there).
+    /// then the tail. Over every object, walking spans is slower on cheap kernels in cache:
+    /// the per-span decoding and mask tests are not free there (`docs/decisions.md`, "A
+    /// plain loop where every object is active").
     #[inline(always)]
     fn range<L: LaneArray>(&mut self, start: usize, end: usize, method: Method, outward: bool) {
         let (w, mut i) = (L::WIDTH, start);

@@ -66,8 +66,8 @@ impl<const N: usize, O: BoxSink<N>> SinkRoute<N> for Store<O> {
 
 impl<const N: usize, F: BoxSink<N>> SinkRoute<N> for Fat<'_, F> {
     /// Columns of boxes and 2D boxes have a route in a transform only: an update's fat sink
-    /// over columns would have cost the library 75K lines of IR (607,114 against 531,692),
-    /// past its budget.
+    /// over columns took the library's IR past its budget (`docs/speed.md`, "Compile time
+    /// of a call site").
     const ROUTE: Route = match F::ROUTE {
         Route::Soa | Route::Aos2 => Route::Generic,
         route => route,

@@ -165,9 +165,8 @@ impl<F> Fat<'_, F> {
     /// The rest of a span where a box left its fat box or did not stand, but for a whole
     /// span that stands (stored inline, [`Sink::span`]): the fat boxes rewritten and the
     /// objects recorded. Out of line: inlined, its code (though rarely run) made LLVM spill
-    /// the hot path, which then ran three times slower. (An inline store of the whole
-    /// spans ran four times slower too, until `Margin::grow`'s closure, which was called
-    /// out of line without the dispatcher's target features, became a function.) It uses
+    /// the hot path (`docs/decisions.md`, "The rare rewrite of a fat sink's span, out of
+    /// line"). It uses
     /// no multiply-add, so it needs none of the dispatcher's target features, and it takes
     /// the portable lanes ([`LaneArray::Portable`]), which code compiled without them can
     /// hold.
@@ -318,7 +317,8 @@ impl Fat<'_, &mut [Aabb3]> {
 
 /// The first `W` boxes as a group: their minima and their maxima. A function, not a
 /// closure: a closure is not inlined into the dispatcher's target features, and called out
-/// of line it passed its groups through memory (the update ran three times slower).
+/// of line it passed its groups through memory (`docs/decisions.md`, "The groups of the
+/// update's fat pass, built by a function").
 #[inline(always)]
 fn join<const W: usize, P: BoxGroup<W>>(boxes: &[Aabb3]) -> (P, P) {
     (

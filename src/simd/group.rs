@@ -53,7 +53,7 @@ fn spread_parts(parts: u32) -> u32 {
 }
 
 /// Two `Vec3A` side by side: the pair on any target (two SSE registers on x86-64), whose
-/// two dependency chains overlap (one box per `Vec3A` ran rigid poses 1.14x slower).
+/// two dependency chains overlap (`docs/decisions.md`, "Two `Vec3A` per group on SSE").
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Two(Vec3A, Vec3A);
 

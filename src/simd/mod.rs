@@ -34,8 +34,8 @@ pub enum Backend {
     /// (x86-64).
     Avx2,
     /// AVX-512F with AVX2 and FMA, chosen at run time (x86-64): the AoS loop runs four boxes
-    /// per 512-bit register, and the lane loop runs [`Backend::Avx2`]'s 8 lanes (16 lanes
-    /// of plain arrays measured 1.6x slower than them, `docs/batch.md`).
+    /// per 512-bit register, and the lane loop runs [`Backend::Avx2`]'s 8 lanes, faster than
+    /// 16 lanes of plain arrays (`docs/decisions.md`, "AVX-512's lane loop on 8 lanes").
     Avx512,
     /// `wide::f32x8`: its instructions fixed at compile time by the build's target
     /// features (two SSE halves on a default x86-64 build, AVX with `target-cpu=native`).
