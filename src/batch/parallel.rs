@@ -142,7 +142,7 @@ impl Batch {
     pub fn transform_par<const N: usize, B, X, O>(
         &self,
         local: B,
-        xf: X,
+        poses: X,
         mut out: O,
     ) -> Result<(), BatchError>
     where
@@ -150,7 +150,7 @@ impl Batch {
         X: PoseSource<N> + Sync,
         O: BoxSink<N>,
     {
-        let len = checked_len(&local, &xf, &mut out)?;
+        let len = checked_len(&local, &poses, &mut out)?;
         let parts_wanted = 4 * rayon::current_num_threads();
         let chunk = len
             .div_ceil(parts_wanted)
@@ -169,7 +169,7 @@ impl Batch {
                         len,
                     },
                     Window {
-                        src: &xf,
+                        src: &poses,
                         start,
                         len,
                     },

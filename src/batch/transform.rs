@@ -18,13 +18,13 @@ impl Batch {
     pub fn transform<const N: usize>(
         &self,
         local: impl BoxSource<N>,
-        xf: impl PoseSource<N>,
+        poses: impl PoseSource<N>,
         mut out: impl BoxSink<N>,
     ) -> Result<(), BatchError> {
-        let len = checked_len(&local, &xf, &mut out)?;
+        let len = checked_len(&local, &poses, &mut out)?;
         let engine = Engine {
             local,
-            poses: xf,
+            poses,
             sink: Store {
                 out,
                 stream: len.saturating_mul(2 * N * size_of::<f32>()) > Self::NON_TEMPORAL_BYTES,

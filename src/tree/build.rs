@@ -41,7 +41,7 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
     #[derive(Clone, Copy)]
     enum ParentLink {
         Root,
-        Child(usize, usize),
+        ChildBox(usize, usize),
     }
     // Past this depth every split is a median split: SAH alone can peel one primitive per
     // level off adversarial input (O(n²)); with the guard the depth, and so the work per
@@ -61,13 +61,13 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
                 median(boxes, range)
             } + start;
             // Right first, so that the left range is placed next (pre-order).
-            work.push((mid, end, ParentLink::Child(index, 1), depth + 1));
-            work.push((start, mid, ParentLink::Child(index, 0), depth + 1));
+            work.push((mid, end, ParentLink::ChildBox(index, 1), depth + 1));
+            work.push((start, mid, ParentLink::ChildBox(index, 0), depth + 1));
             Ref::node(index as u32)
         };
         match slot {
             ParentLink::Root => root = r,
-            ParentLink::Child(parent, side) => children[parent][side] = r,
+            ParentLink::ChildBox(parent, side) => children[parent][side] = r,
         }
     }
     Topology { children, root }

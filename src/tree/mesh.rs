@@ -1,5 +1,5 @@
 //! The objects a tree is built over: [`TriMesh`] (triangles, boxes derived from vertices)
-//! and [`AabbTree`] (bare primitive boxes), each with its [`Hierarchy`].
+//! and [`AabbTree`] (bare primitive boxes), each with its [`Bvh`].
 
 use alloc::vec::Vec;
 use core::fmt;
@@ -84,18 +84,18 @@ impl core::error::Error for MeshError {}
 
 /// A tree over primitives: the nodes in a [`Layout`], the root and the reach.
 #[derive(Clone, Debug)]
-pub(crate) struct Hierarchy<L> {
+pub(crate) struct Bvh<L> {
     pub layout: L,
     pub root: Ref,
     /// Every box of the tree (primitives', and every box as stored) lies within `±reach` on
-    /// every axis, to within `2^-52` relative ([`Hierarchy::measure`]).
+    /// every axis, to within `2^-52` relative ([`Bvh::measure`]).
     pub reach: f64,
 }
 
-impl<L: Layout> Hierarchy<L> {
+impl<L: Layout> Bvh<L> {
     fn new(boxes: &[PrimBox]) -> Self {
         let topology = build::build(boxes);
-        let mut h = Hierarchy {
+        let mut h = Bvh {
             layout: build::layout(&topology.children, |i| boxes[i as usize]),
             root: topology.root,
             reach: 0.0,
@@ -185,7 +185,7 @@ fn prim_boxes(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<PrimBox> {
 pub struct TriMesh<L: Layout = Compact> {
     vertices: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
-    pub(crate) tree: Hierarchy<L>,
+    pub(crate) tree: Bvh<L>,
 }
 
 impl TriMesh<Compact> {
@@ -210,7 +210,7 @@ impl<L: Layout> TriMesh<L> {
             }
         }
         check_vertices(&vertices)?;
-        let tree = Hierarchy::new(&prim_boxes(&vertices, &triangles));
+        let tree = Bvh::new(&prim_boxes(&vertices, &triangles));
         Ok(TriMesh {
             vertices,
             triangles,
@@ -229,7 +229,7 @@ impl<L: Layout> TriMesh<L> {
         TriMesh {
             vertices: self.vertices.clone(),
             triangles: self.triangles.clone(),
-            tree: Hierarchy {
+            tree: Bvh {
                 layout: build::layout(&self.tree.children(), |i| boxes[i as usize]),
                 root: self.tree.root,
                 reach: 0.0,
@@ -321,7 +321,7 @@ impl<L: Layout> TriMesh<L> {
 #[derive(Clone, Debug)]
 pub struct AabbTree<L: Layout = Compact> {
     boxes: Vec<Aabb3>,
-    pub(crate) tree: Hierarchy<L>,
+    pub(crate) tree: Bvh<L>,
 }
 
 fn to_prims(boxes: &[Aabb3]) -> Result<Vec<PrimBox>, MeshError> {
@@ -355,7 +355,7 @@ impl<L: Layout> AabbTree<L> {
         let prims = to_prims(boxes)?;
         Ok(AabbTree {
             boxes: boxes.to_vec(),
-            tree: Hierarchy::new(&prims),
+            tree: Bvh::new(&prims),
         })
     }
 

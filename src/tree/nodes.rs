@@ -71,7 +71,7 @@ impl Ref {
 
 /// A compact node: `center ± extent` and two children (32 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Node {
+pub(crate) struct CompactNode {
     pub center: [f32; 3],
     pub extent: [f32; 3],
     pub children: [Ref; 2],
@@ -132,7 +132,7 @@ pub(crate) trait NodeAccess {
     ) -> Self;
     /// The two children of node `i` with their boxes `(center, extent)` as the queries read
     /// them; a primitive's box from `prim` where the layout does not store it.
-    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2];
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [ChildBox; 2];
     /// The box of the tree's root `root`, as the queries read it (`prim` as above).
     fn root_box(&self, root: Ref, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> (Vec3A, Vec3A);
     /// The largest `|coordinate|` of any box the layout stores, in `f64`: finite for every
@@ -152,7 +152,7 @@ pub(crate) trait NodeAccess {
 
 /// A child as the descent reads it: its reference and its box `center ± extent`.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Child {
+pub(crate) struct ChildBox {
     pub r: Ref,
     pub center: Vec3A,
     pub extent: Vec3A,
@@ -180,10 +180,10 @@ fn own_boxes(
     children: [Ref; 2],
     node: impl Fn(u32) -> (Vec3A, Vec3A),
     prim: impl Fn(u32) -> (Vec3A, Vec3A),
-) -> [Child; 2] {
+) -> [ChildBox; 2] {
     let child = |r: Ref| {
         let (center, extent) = own_box(r, &node, &prim);
-        Child { r, center, extent }
+        ChildBox { r, center, extent }
     };
     [child(children[0]), child(children[1])]
 }
@@ -198,7 +198,7 @@ fn reach_of(boxes: impl Iterator<Item = (DVec3, DVec3)>) -> f64 {
 /// Nodes of 32 bytes: an `f32` center and extent, two child references.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Compact {
-    nodes: Vec<Node>,
+    nodes: Vec<CompactNode>,
 }
 
 impl Layout for Compact {}
@@ -223,7 +223,7 @@ impl NodeAccess for Compact {
             .zip(min.iter().zip(max))
             .map(|(&children, (&lo, &hi))| {
                 let (center, extent) = outward(lo, hi);
-                Node {
+                CompactNode {
                     center,
                     extent,
                     children,
@@ -233,7 +233,7 @@ impl NodeAccess for Compact {
         Compact { nodes }
     }
     #[inline(always)]
-    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [ChildBox; 2] {
         own_boxes(self.children(i), |j| self.node_box(j), prim)
     }
     #[inline(always)]
@@ -254,7 +254,7 @@ impl NodeAccess for Compact {
         self.nodes.len()
     }
     fn bytes(&self) -> usize {
-        self.nodes.len() * core::mem::size_of::<Node>()
+        self.nodes.len() * core::mem::size_of::<CompactNode>()
     }
 }
 
@@ -379,7 +379,7 @@ impl NodeAccess for Quantized {
         }
     }
     #[inline(always)]
-    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+    fn children_boxes(&self, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [ChildBox; 2] {
         own_boxes(self.children(i), |j| self.node_box(j), prim)
     }
     #[inline(always)]
@@ -490,11 +490,11 @@ impl NodeAccess for Paired {
         }
     }
     #[inline(always)]
-    fn children_boxes(&self, i: u32, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [Child; 2] {
+    fn children_boxes(&self, i: u32, _prim: impl Fn(u32) -> (Vec3A, Vec3A)) -> [ChildBox; 2] {
         let n = &self.nodes[i as usize];
         let [(c0, e0), (c1, e1)] = crate::simd::grid_pair(&n.grid);
         // As `grid_box`: `step·c` and `step·e` exact, the sum rounded once.
-        let child = |r: Ref, c: Vec3A, e: Vec3A| Child {
+        let child = |r: Ref, c: Vec3A, e: Vec3A| ChildBox {
             r,
             center: self.origin + self.step * c,
             extent: self.step * e,

@@ -6,8 +6,8 @@ use core::ops::ControlFlow;
 
 use glam::{DVec3, Vec3A};
 
-use super::mesh::{AabbTree, Hierarchy, TriMesh, triangle_box};
-use super::nodes::{Child, Layout, NodeAccess, Ref};
+use super::mesh::{AabbTree, Bvh, TriMesh, triangle_box};
+use super::nodes::{ChildBox, Layout, NodeAccess, Ref};
 use super::relative::{AxesOf, Crosswise, Lanes, QueryError, Relative};
 use super::triangle::{
     LANES, TriangleLanes, filter_batch, triangles_distance_sq, triangles_intersect,
@@ -20,7 +20,7 @@ pub trait Shape: Primitives {}
 /// The crate-private access of the descent: the tree, and a primitive's box.
 pub(crate) trait Primitives {
     type Nodes: Layout;
-    fn hierarchy(&self) -> &Hierarchy<Self::Nodes>;
+    fn hierarchy(&self) -> &Bvh<Self::Nodes>;
     /// Primitive `id`'s box as `(center, extent)` in the object's frame.
     fn primitive_box(&self, id: u32) -> (Vec3A, Vec3A);
 }
@@ -29,7 +29,7 @@ impl<L: Layout> Shape for TriMesh<L> {}
 impl<L: Layout> Primitives for TriMesh<L> {
     type Nodes = L;
     #[inline(always)]
-    fn hierarchy(&self) -> &Hierarchy<L> {
+    fn hierarchy(&self) -> &Bvh<L> {
         &self.tree
     }
     #[inline(always)]
@@ -42,7 +42,7 @@ impl<L: Layout> Shape for AabbTree<L> {}
 impl<L: Layout> Primitives for AabbTree<L> {
     type Nodes = L;
     #[inline(always)]
-    fn hierarchy(&self) -> &Hierarchy<L> {
+    fn hierarchy(&self) -> &Bvh<L> {
         &self.tree
     }
     #[inline(always)]
@@ -171,9 +171,8 @@ impl<'a, A: Shape, B: Shape> Query<'a, A, B> {
     ///
     /// `batch` is called through a reference to a trait object, once per batch: the
     /// descent is compiled once per pair of shapes and backend in the user's crate, not
-    /// once more for every caller's closure (measured: a call site with `intersects` and
-    /// `overlapping_triangles` compiled to 31,226 lines of optimised IR with the closure
-    /// generic; see `docs/speed.md`).
+    /// once more for every caller's closure (the IR of a call site with the closure generic
+    /// is in `docs/speed.md` and `docs/trees.md`).
     fn descend(&self, flush_at: usize, batch: &mut OnBatch<'_>) -> (ControlFlow<()>, Stats) {
         // Compiled in the best backend's dispatch wrapper (three-operand vector
         // instructions, fewer spills of the query's 15 vectors); plain arithmetic, unfused.
@@ -350,7 +349,7 @@ impl<A: Shape, B: Shape> Query<'_, A, B> {
 /// node replaced by its own two children (the step skips that level: a box test skipped
 /// only culls less). Up to four, in descent order, in lanes; `valid` marks the lanes used.
 struct Below {
-    kids: [Child; 4],
+    kids: [ChildBox; 4],
     valid: u32,
     lanes: Lanes,
 }
@@ -358,7 +357,7 @@ struct Below {
 impl Below {
     #[inline(always)]
     fn new<L: NodeAccess>(layout: &L, i: u32, prim: impl Fn(u32) -> (Vec3A, Vec3A) + Copy) -> Self {
-        let open = |c: Child| {
+        let open = |c: ChildBox| {
             if c.r.is_primitive() {
                 ([c, c], 0b01)
             } else {
@@ -381,7 +380,7 @@ impl Below {
 
 /// Bit `l` set for the children that are primitives.
 #[inline(always)]
-fn primitives(kids: &[Child; 2]) -> u32 {
+fn primitives(kids: &[ChildBox; 2]) -> u32 {
     kids[0].r.0 >> 31 | (kids[1].r.0 >> 31) << 1
 }
 
