@@ -113,10 +113,11 @@ impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: SinkRoute<N>> Engine<
         let predicted = poses.named_predicted();
         match (local.named_boxes(), poses.named_poses(), sink.named()) {
             (Some(NamedBoxes::Aos(local)), Some(NamedPoses::Aos(poses)), Some(sink)) => {
-                let predicted = match predicted {
-                    None => None,
-                    Some(NamedPoses::Aos(predicted)) => Some(predicted),
-                    Some(_) => mismatch(),
+                // A swept run has its predicted poses, and only a swept run.
+                let predicted = match (Self::ROUTE, predicted) {
+                    (Route::Aos, None) => None,
+                    (Route::Swept, Some(NamedPoses::Aos(predicted))) => Some(predicted),
+                    _ => mismatch(),
                 };
                 match sink {
                     NamedSink::Store {
