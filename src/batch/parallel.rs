@@ -74,17 +74,17 @@ impl<S: Named> Named for Window<'_, S> {
     }
     #[inline(always)]
     fn named_poses(&self) -> Option<NamedPoses<'_>> {
-        self.window(self.src.named_poses()?)
+        self.cut(self.src.named_poses()?)
     }
     #[inline(always)]
     fn named_predicted(&self) -> Option<NamedPoses<'_>> {
-        self.window(self.src.named_predicted()?)
+        self.cut(self.src.named_predicted()?)
     }
 }
 
 impl<S> Window<'_, S> {
     /// The window's part of AoS poses by name (any other name has no route in a part).
-    fn window<'p>(&self, poses: NamedPoses<'p>) -> Option<NamedPoses<'p>> {
+    fn cut<'p>(&self, poses: NamedPoses<'p>) -> Option<NamedPoses<'p>> {
         match poses {
             NamedPoses::Aos(poses) => window(poses, self.start, self.len).map(NamedPoses::Aos),
             NamedPoses::Blocks(_) | NamedPoses::Soa(_) | NamedPoses::Aos2(_) => None,

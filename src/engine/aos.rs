@@ -244,13 +244,13 @@ impl AosCall<'_> {
     /// The lane loop with `poses` into `sink`, on the scalar backend.
     fn sink<P: PoseSource<3>>(self, poses: P, sink: AosSink<'_>) {
         match sink {
-            AosSink::Store(out) => self.lane_loop(poses, Store { out, stream: false }),
-            AosSink::Fat(fat, _) => self.lane_loop(poses, fat),
+            AosSink::Store(out) => self.scalar_lane_loop(poses, Store { out, stream: false }),
+            AosSink::Fat(fat, _) => self.scalar_lane_loop(poses, fat),
         }
     }
 
     /// The lane loop with `poses` into `sink`, in the scalar reference's lanes.
-    fn lane_loop<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
+    fn scalar_lane_loop<P: PoseSource<3>>(self, poses: P, sink: impl Sink<3>) {
         debug_assert_eq!(self.backend, Backend::Scalar);
         let engine = Engine {
             local: self.local,

@@ -179,9 +179,11 @@ impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: SinkRoute<N>> Engine<
 }
 
 /// The one arm no run reaches: [`Route::of`] gives a route other than
-/// [`Route::Generic`] only when the boxes, poses and output each have that `ROUTE`, and
-/// every layout and sink names itself with that route's variant whenever its `ROUTE` says
-/// so (a test in `batch` checks each layout, pose kind and sink).
+/// [`Route::Generic`] only when the boxes, poses and output name it together (the
+/// poses `Swept` with AoS boxes and output for [`Route::Swept`]); every layout and sink
+/// names itself with its route's variants whenever its `ROUTE` says so, and a swept pair
+/// names its predicted poses too (a test in `batch` checks each layout, pose kind and
+/// sink).
 #[cold]
 fn mismatch() -> ! {
     unreachable!("a run on a route is named by that route's variants (tested in batch)")

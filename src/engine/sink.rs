@@ -166,10 +166,9 @@ impl<F> Fat<'_, F> {
     /// span that stands (stored inline, [`Sink::span`]): the fat boxes rewritten and the
     /// objects recorded. Out of line: inlined, its code (though rarely run) made LLVM spill
     /// the hot path (`docs/decisions.md`, "The rare rewrite of a fat sink's span, out of
-    /// line"). It uses
-    /// no multiply-add, so it needs none of the dispatcher's target features, and it takes
-    /// the portable lanes ([`LaneArray::Portable`]), which code compiled without them can
-    /// hold.
+    /// line"). It uses no multiply-add, so it needs none of the dispatcher's target
+    /// features, and it takes the portable lanes ([`LaneArray::Portable`]), which code
+    /// compiled without them can hold.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
     fn rewrite<L: LaneArray, const N: usize>(

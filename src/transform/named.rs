@@ -71,7 +71,8 @@ pub enum NamedBoxesMut<'a> {
     Aos2(&'a mut [Aabb2]),
 }
 
-/// Poses on a [`Route`], by name (one variant per route that takes poses).
+/// Poses on a [`Route`], by name: one variant per layout of a route's poses (a
+/// [`Swept`](crate::Swept) pair names each end [`NamedPoses::Aos`]).
 #[derive(Clone, Copy)]
 pub enum NamedPoses<'a> {
     /// AoS or shared poses of a 3D class.

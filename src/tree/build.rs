@@ -37,18 +37,19 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
     let mut ids: Vec<u32> = (0..n as u32).collect();
     let mut children: Vec<[Ref; 2]> = Vec::with_capacity(n.saturating_sub(1));
     let mut root = Ref::primitive(0);
-    // (start, end, slot): the range to place and where its reference goes.
+    // (start, end, link, depth): the range to place, where its reference goes, and its
+    // depth.
     #[derive(Clone, Copy)]
     enum ParentLink {
         Root,
-        ChildBox(usize, usize),
+        Child(usize, usize),
     }
     // Past this depth every split is a median split: SAH alone can peel one primitive per
     // level off adversarial input (O(n²)); with the guard the depth, and so the work per
     // primitive, stays O(log n).
     let max_depth = 2 * (usize::BITS - n.leading_zeros()) as usize + 16;
     let mut work = vec![(0usize, n, ParentLink::Root, 0usize)];
-    while let Some((start, end, slot, depth)) = work.pop() {
+    while let Some((start, end, link, depth)) = work.pop() {
         let r = if end - start == 1 {
             Ref::primitive(ids[start])
         } else {
@@ -61,13 +62,13 @@ pub(crate) fn build(boxes: &[PrimBox]) -> Topology {
                 median(boxes, range)
             } + start;
             // Right first, so that the left range is placed next (pre-order).
-            work.push((mid, end, ParentLink::ChildBox(index, 1), depth + 1));
-            work.push((start, mid, ParentLink::ChildBox(index, 0), depth + 1));
+            work.push((mid, end, ParentLink::Child(index, 1), depth + 1));
+            work.push((start, mid, ParentLink::Child(index, 0), depth + 1));
             Ref::node(index as u32)
         };
-        match slot {
+        match link {
             ParentLink::Root => root = r,
-            ParentLink::ChildBox(parent, side) => children[parent][side] = r,
+            ParentLink::Child(parent, side) => children[parent][side] = r,
         }
     }
     Topology { children, root }
