@@ -85,13 +85,18 @@ impl<const N: usize, F: BoxSink<N>> SinkRoute<N> for Fat<'_, F> {
 impl<const N: usize, B: BoxSource<N>, P: PoseSource<N>, S: SinkRoute<N>> Engine<'_, N, B, P, S> {
     /// The route of this run: the one its boxes, poses and output all name.
     pub(crate) const ROUTE: Route = Route::of(B::ROUTE, P::ROUTE, S::ROUTE);
+    /// No route: the lane loop, compiled at the call site. A `bool` constant, so that the
+    /// branch below is decided before monomorphization: a `matches!` on [`Self::ROUTE`]
+    /// is not, and a call site then compiled the lane loop too (5.3 s against 0.46 s for
+    /// `tests/callsite`'s release rebuild, Intel Xeon; the single-unit IR count hid it).
+    const GENERIC: bool = matches!(Self::ROUTE, Route::Generic);
 
     /// Runs on `backend` (`fused` lets the lanes fuse multiply-adds): on the run's
     /// [`Route`], in code compiled once in bvkit; without one, in the lane loop compiled
     /// here.
     #[inline(always)]
     pub fn run(self, backend: Backend, fused: bool) {
-        if matches!(Self::ROUTE, Route::Generic) {
+        if Self::GENERIC {
             return self.run_lanes(backend, fused);
         }
         let Engine {
