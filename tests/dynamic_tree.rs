@@ -235,6 +235,45 @@ fn a_rebuild_spread_over_frames_misses_no_change_made_meanwhile() {
     assert!(refused > 50, "{refused} boxes refused");
 }
 
+/// The frame (counted from 1) in which the upkeep's first rebuild takes over, when each
+/// frame writes `per_frame` of 1000 proxies (in turn) and calls `maintain`, with the default
+/// trigger (16 moves per proxy) and spread (32 calls).
+fn first_takeover(per_frame: usize) -> Option<usize> {
+    let fat: Vec<Aabb3> = (0..1000)
+        .map(|i| {
+            let c = Vec3A::new((i % 10) as f32, (i / 10 % 10) as f32, (i / 100) as f32);
+            Aabb3::new(c, c + 0.6)
+        })
+        .collect();
+    let mut tree = DynamicTree::from_boxes(&fat).unwrap();
+    let mut next = 0;
+    (1..=20_000).find(|_| {
+        let mut moved: Vec<u32> = (next..next + per_frame)
+            .map(|i| (i % 1000) as u32)
+            .collect();
+        moved.sort_unstable();
+        next += per_frame;
+        tree.write(&moved, &fat).unwrap();
+        tree.maintain()
+    })
+}
+
+#[test]
+fn where_most_proxies_move_a_rebuild_takes_over_before_they_moved_a_quarter_of_its_trigger() {
+    // Every proxy moves every frame: the rebuild starts in frame 17 (past 16 moves each) and
+    // must take over once they have moved 4 times more each, in frame 20 (it would take
+    // about 32 calls at its spread's own pace).
+    let fast = first_takeover(1000);
+    assert_eq!(fast, Some(20), "took over in frame {fast:?}");
+    // One proxy in a hundred moves each frame: the rebuild starts in frame 1601 and keeps to
+    // its spread, about 32 calls.
+    let slow = first_takeover(10);
+    assert!(
+        matches!(slow, Some(1625..=1641)),
+        "took over in frame {slow:?}"
+    );
+}
+
 #[test]
 fn a_rebuild_takes_over_after_about_as_many_calls_as_it_is_spread_over() {
     let fat: Vec<Aabb3> = (0..1000)

@@ -226,6 +226,16 @@ impl Places for Placer<'_> {
     }
 }
 
+/// A spread rebuild under way (`rebuild.rs`): its tier, the least work of each step, the
+/// work left, and its tier's moves at its last step.
+#[derive(Clone, Copy, Debug)]
+struct Rebuild {
+    tier: Tier,
+    budget: usize,
+    left: usize,
+    seen: u64,
+}
+
 /// A box the tree accepts: every face finite, `min <= max`.
 fn accepts(b: &Aabb3) -> bool {
     b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()
@@ -286,8 +296,8 @@ pub struct DynamicTree {
     /// for their memory.
     spare: Hierarchy,
     spare_at: Vec<Place>,
-    /// The tier a rebuild under way is for, and the budget of each of its steps.
-    rebuilding: Option<(Tier, usize)>,
+    /// The rebuild under way.
+    rebuilding: Option<Rebuild>,
     /// The proxies inserted, removed, parked, unparked or moved between tiers since the
     /// rebuild under way began.
     replay: Vec<u32>,

@@ -1,7 +1,7 @@
 //! The tree's upkeep: a new hierarchy built beside the one in use, a share of the work a
 //! frame, which takes over when done.
 
-use super::{DynamicTree, Place, Placer, Tier};
+use super::{DynamicTree, Place, Placer, Rebuild, Tier};
 use crate::broadphase::hierarchy::{Hierarchy, Slot};
 use core::mem::take;
 
@@ -10,6 +10,12 @@ use core::mem::take;
 /// one leaves their hierarchy unbalanced until a build.
 const FIXED_PATIENCE: f32 = 32.0;
 
+/// A spread rebuild takes over before its proxies have taken this share of the moves each
+/// that started it: it builds from the boxes of its start, so where most proxies move every
+/// frame a rebuild spread over many frames is stale when it takes over
+/// (`docs/decisions.md`, "A spread rebuild's deadline where proxies move fast").
+const STALE_SHARE: f32 = 0.25;
+
 impl DynamicTree {
     /// Rebuilds both hierarchies from their proxies, balanced (near-median splits of the
     /// widest spread of centres, every node full but those on one path from the root).
@@ -17,7 +23,7 @@ impl DynamicTree {
     /// loose or mixed distant proxies under one node.
     pub fn rebuild(&mut self) {
         for tier in [Tier::Moving, Tier::Fixed] {
-            self.begin_rebuild(tier, usize::MAX);
+            self.begin_rebuild(tier, usize::MAX, usize::MAX);
             self.continue_rebuild();
         }
     }
@@ -44,8 +50,11 @@ impl DynamicTree {
     /// hierarchy has taken enough moves since its last build
     /// ([`DynamicTree::set_rebuild_after`]) a new one is built beside it, a share of the
     /// work in each call ([`DynamicTree::set_rebuild_frames`]), while the old one serves
-    /// the frames: no frame pays for a whole rebuild. Until the new hierarchy takes over,
-    /// each write goes to both, and proxies inserted or removed meanwhile are brought up
+    /// the frames: no frame pays for a whole rebuild. Where proxies move fast, each call
+    /// takes a larger share, so that the new hierarchy takes over before its proxies have
+    /// taken a quarter of that many moves each since it began (at the rate of the last
+    /// frame), since a rebuild starts from the boxes of its first frame. Until the new
+    /// hierarchy takes over, each write goes to both, and proxies inserted or removed meanwhile are brought up
     /// to date in it when its build is done. Returns true when a new hierarchy took over.
     /// Boxes and pairs do not change; the rebuild needs a second hierarchy's memory, kept
     /// between rebuilds (its nodes, 256 bytes per about 7 proxies after a build, the
@@ -53,32 +62,28 @@ impl DynamicTree {
     /// One hierarchy is rebuilt at a time, the static proxies' first when both are due.
     pub fn maintain(&mut self) -> bool {
         if self.rebuilding.is_none() {
-            let due = |tier: Tier, patience: f32| {
-                let proxies = self.tier_len[tier as usize].max(1) as f32;
-                self.moves[tier as usize] as f32 > self.rebuild_after / patience * proxies
-            };
-            let tier = if due(Tier::Fixed, FIXED_PATIENCE) {
+            let due = |tier: Tier| self.moves[tier as usize] > self.trigger(tier);
+            let tier = if due(Tier::Fixed) {
                 Tier::Fixed
-            } else if due(Tier::Moving, 1.0) {
+            } else if due(Tier::Moving) {
                 Tier::Moving
             } else {
                 return false;
             };
+            let work = Hierarchy::build_work(self.tier_len[tier as usize]);
             let budget = match self.rebuild_frames {
                 1 => usize::MAX,
-                frames => Hierarchy::build_work(self.tier_len[tier as usize])
-                    .div_ceil(frames as usize)
-                    .max(1),
+                frames => work.div_ceil(frames as usize).max(1),
             };
-            self.begin_rebuild(tier, budget);
+            self.begin_rebuild(tier, budget, work);
         }
         self.continue_rebuild()
     }
 
-    /// Starts a rebuild of `tier` into the spare hierarchy from its proxies as they are, to
-    /// advance by `budget` units of work per [`DynamicTree::continue_rebuild`]. A rebuild
-    /// under way is dropped.
-    fn begin_rebuild(&mut self, tier: Tier, budget: usize) {
+    /// Starts a rebuild of `tier` into the spare hierarchy from its proxies as they are, of
+    /// about `work` units, to advance by at least `budget` units per
+    /// [`DynamicTree::continue_rebuild`]. A rebuild under way is dropped.
+    fn begin_rebuild(&mut self, tier: Tier, budget: usize, work: usize) {
         let from = match tier {
             Tier::Moving => &self.moving,
             Tier::Fixed => &self.fixed,
@@ -93,7 +98,12 @@ impl DynamicTree {
                 None => at,
             }));
         self.replay.clear();
-        self.rebuilding = Some((tier, budget));
+        self.rebuilding = Some(Rebuild {
+            tier,
+            budget,
+            left: work,
+            seen: 0,
+        });
         self.moves[tier as usize] = 0;
     }
 
@@ -101,9 +111,26 @@ impl DynamicTree {
     /// proxies inserted, removed, parked, unparked or moved between tiers meanwhile up to
     /// date in it and makes it the tier's hierarchy. Returns true then.
     fn continue_rebuild(&mut self) -> bool {
-        let Some((tier, budget)) = self.rebuilding else {
+        let Some(tier) = self.rebuilding.map(|r| r.tier) else {
             return false;
         };
+        let deadline = (self.trigger(tier) as f32 * STALE_SHARE) as u64;
+        let Some(rebuild) = &mut self.rebuilding else {
+            return false;
+        };
+        // The frames left before the deadline, at the rate of moves since the last step,
+        // share the work left.
+        let moves = self.moves[tier as usize];
+        let rate = moves.saturating_sub(rebuild.seen);
+        rebuild.seen = moves;
+        let budget = match rate {
+            0 => rebuild.budget,
+            rate => {
+                let frames = (deadline.saturating_sub(moves) / rate).max(1) as usize;
+                rebuild.budget.max(rebuild.left.div_ceil(frames))
+            }
+        };
+        rebuild.left = rebuild.left.saturating_sub(budget);
         let (hierarchy, at) = (
             match tier {
                 Tier::Moving => &self.moving,
@@ -158,10 +185,26 @@ impl DynamicTree {
         true
     }
 
+    /// The moves and inserts since its last build past which `tier` is rebuilt.
+    fn trigger(&self, tier: Tier) -> u64 {
+        let patience = match tier {
+            Tier::Moving => 1.0,
+            Tier::Fixed => FIXED_PATIENCE,
+        };
+        let proxies = self.tier_len[tier as usize].max(1) as f32;
+        let moves = self.rebuild_after / patience * proxies;
+        // An infinite or NaN trigger is never reached (the cast saturates, NaN would be 0).
+        if moves.is_nan() {
+            u64::MAX
+        } else {
+            moves as u64
+        }
+    }
+
     /// Proxy `id`'s slot in the hierarchy a rebuild under way fills, once placed there.
     #[inline(always)]
     pub(super) fn spare_slot(&self, id: u32) -> Option<Slot> {
-        let (tier, _) = self.rebuilding?;
+        let tier = self.rebuilding?.tier;
         self.spare_at.get(id as usize)?.slot_in(tier)
     }
 
