@@ -27,7 +27,8 @@
 //! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity (`bvh`),
 //! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
 //! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
-//! leaves R out, `--check-all` checks every frame and `--no-check` none (for profiling), `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
+//! leaves R out, `--avx2` runs C's update on the AVX2 backend (the widest this CPU runs
+//! otherwise), `--check-all` checks every frame and `--no-check` none (for profiling), `--relative R` and `--partial K` tune B, and `--rebuild-after M` and
 //! `--rebuild-frames F` tune C's upkeep; `--level M` adds M static boxes to C's tree at the bodies'
 //! density around the scene, `--floor M` a floor of M static tiles under it, `--far M` M
 //! static boxes 3 km away, and `--layers K`
@@ -71,6 +72,7 @@ fn main() {
             (None, None, None) => bvh::Level::None,
         },
         layers: option("--layers").unwrap_or(0.0) as u32,
+        backend: None,
     };
     let speed = option("--speed").unwrap_or(1.0) as f32;
     // `--name`, taken out of the positional arguments.
@@ -84,6 +86,10 @@ fn main() {
     let rapier = !flag("--no-rapier");
     let check_all = flag("--check-all");
     let no_check = flag("--no-check");
+    let tuning = bvh::Tuning {
+        backend: flag("--avx2").then_some(bvkit::Backend::Avx2),
+        ..tuning
+    };
     let arg = |k: usize, default: f64| {
         args.get(k)
             .map_or(default, |a| a.parse().expect("a number"))

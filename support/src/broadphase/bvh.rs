@@ -92,6 +92,9 @@ pub struct Tuning {
     /// `i % k` only, pairing with it only (so 1 puts every proxy in one layer, through the
     /// filter's checks).
     pub layers: u32,
+    /// The backend of C's (and B's) update, where given; the widest this CPU runs
+    /// otherwise (`Batch::new`).
+    pub backend: Option<bvkit::Backend>,
 }
 
 /// A level of static boxes in C's tree, which the bodies move among.
@@ -333,6 +336,10 @@ impl Pipelines {
             }
         });
         let batch = Batch::new(Method::AbsMatrix, Rounding::Outward);
+        let batch = match tuning.backend {
+            Some(backend) => batch.on(backend).expect("a backend this CPU runs"),
+            None => batch,
+        };
         let margin = Margin::new(MARGIN, tuning.relative);
         let local8 = Aabb3x8::pack(&scene.local);
         let poses8 = Rigid3x8::pack(&scene.poses);
