@@ -17,14 +17,17 @@
 //!   sweep, R's pairs and A's and B's trees against the exact boxes) and fails on any error;
 //!   above, every fifth frame.
 //! - `cargo run --release --features peers --example broadphase tree [T]`: C against R on
-//!   four scenes, T frames each (default 60, so that the trees reach their steady state
+//!   six scenes, T frames each (default 60, so that the trees reach their steady state
 //!   under motion): 1M bodies half asleep, 100K all awake, 100K all awake moving 8 times as
-//!   fast, where most bodies leave their fat box every frame, and the 1M half asleep as
-//!   fast; checked every fifth frame. The last line reads `frame_vs_rapier_1m=R1
-//!   frame_vs_rapier_100k=R2 frame_vs_rapier_most_move=R3 frame_vs_rapier_1m_most_move=R4
-//!   missing_pairs=M`.
+//!   fast, where most bodies leave their fat box every frame, the 1M half asleep as fast,
+//!   and the 100K packed six times closer (a pile: several overlapping pairs a body, where
+//!   the sparse scenes have far under one) at both speeds; checked every fifth frame. The
+//!   last line reads `frame_vs_rapier_1m=R1 frame_vs_rapier_100k=R2
+//!   frame_vs_rapier_most_move=R3 frame_vs_rapier_1m_most_move=R4 frame_vs_rapier_pile=R5
+//!   frame_vs_rapier_pile_most_move=R6 missing_pairs=M`.
 //!
-//! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity (`bvh`),
+//! Options of the `bvh` and `tree` modes: `--speed S` multiplies every velocity and
+//! `--packed F` packs the bodies F times closer along each axis (`bvh`),
 //! `--obvhs` adds D, obvhs's `Bvh2` fed by C's update (the tree avian uses; about 0.4 s a
 //! frame at 1M), `--models` adds A and B to `tree` (`--no-models` leaves them out of `bvh`), `--no-rapier`
 //! leaves R out, `--avx2` runs C's update on the AVX2 backend (the widest this CPU runs
@@ -75,6 +78,7 @@ fn main() {
         backend: None,
     };
     let speed = option("--speed").unwrap_or(1.0) as f32;
+    let packed = option("--packed").unwrap_or(1.0) as f32;
     // `--name`, taken out of the positional arguments.
     let mut flag = |name: &str| {
         let k = args.iter().position(|a| a == name);
@@ -121,7 +125,7 @@ fn main() {
                 (true, _) => Check::Every,
                 _ => Check::Sampled(5),
             };
-            let scene = Scene::new(n, asleep, island).fast(speed);
+            let scene = Scene::new(n, asleep, island).packed(packed).fast(speed);
             let summary = bvh::run(scene, frames, tuning, which, check);
             assert_eq!(
                 summary.missing + summary.wrong + summary.rapier_missing,
@@ -141,6 +145,11 @@ fn tree(frames: usize, tuning: bvh::Tuning, which: Which, check: Check) {
         ("100k", Scene::new(100_000, 0.0, 256)),
         ("most_move", Scene::new(100_000, 0.0, 256).fast(8.0)),
         ("1m_most_move", Scene::new(1_000_000, 0.5, 256).fast(8.0)),
+        ("pile", Scene::new(100_000, 0.0, 256).packed(6.0)),
+        (
+            "pile_most_move",
+            Scene::new(100_000, 0.0, 256).packed(6.0).fast(8.0),
+        ),
     ];
     let mut line = Vec::new();
     let mut missing = 0;
