@@ -54,8 +54,8 @@ impl DynamicTree {
     /// takes a larger share, so that the new hierarchy takes over before its proxies have
     /// taken a quarter of that many moves each since it began (at the rate of the last
     /// frame), since a rebuild starts from the boxes of its first frame. Until the new
-    /// hierarchy takes over, each write goes to both, and proxies inserted or removed meanwhile are brought up
-    /// to date in it when its build is done. Returns true when a new hierarchy took over.
+    /// hierarchy takes over, each write goes to both, and proxies inserted or removed
+    /// meanwhile are brought up to date in it when its build is done. Returns true when a new hierarchy took over.
     /// Boxes and pairs do not change; the rebuild needs a second hierarchy's memory, kept
     /// between rebuilds (its nodes, 256 bytes per about 7 proxies after a build, the
     /// centres it sorts, 16 bytes per proxy, and the proxies' slots in it, 4 bytes per id).
