@@ -111,15 +111,13 @@ impl DynamicTree {
     /// proxies inserted, removed, parked, unparked or moved between tiers meanwhile up to
     /// date in it and makes it the tier's hierarchy. Returns true then.
     fn continue_rebuild(&mut self) -> bool {
-        let Some(tier) = self.rebuilding.map(|r| r.tier) else {
+        let Some(mut rebuild) = self.rebuilding else {
             return false;
         };
-        let deadline = (self.trigger(tier) as f32 * STALE_SHARE) as u64;
-        let Some(rebuild) = &mut self.rebuilding else {
-            return false;
-        };
+        let tier = rebuild.tier;
         // The frames left before the deadline, at the rate of moves since the last step,
         // share the work left.
+        let deadline = (self.trigger(tier) as f32 * STALE_SHARE) as u64;
         let moves = self.moves[tier as usize];
         let rate = moves.saturating_sub(rebuild.seen);
         rebuild.seen = moves;
@@ -131,6 +129,7 @@ impl DynamicTree {
             }
         };
         rebuild.left = rebuild.left.saturating_sub(budget);
+        self.rebuilding = Some(rebuild);
         let (hierarchy, at) = (
             match tier {
                 Tier::Moving => &self.moving,
